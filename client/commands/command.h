@@ -1,0 +1,16 @@
+#pragma once
+// Each `rrg` subcommand lives in one file under client/commands/ and registers itself here.
+// A command's callback throws on error; rrg_main turns the exception into a message and exit code.
+#include <CLI/CLI.hpp>
+
+namespace rrg::cli {
+
+// Exit codes: 0 ok, 1 runtime failure (bad data, I/O), 2 usage error (bad flags; CLI11's own).
+inline constexpr int kExitFailure = 1;
+
+void register_synth_command(CLI::App& app);    // rrg synth
+void register_eval_command(CLI::App& app);     // rrg eval ate|images|mesh
+void register_dataset_command(CLI::App& app);  // rrg dataset info
+void register_device_command(CLI::App& app);   // rrg devices
+
+}  // namespace rrg::cli

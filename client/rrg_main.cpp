@@ -1,0 +1,31 @@
+// rrg: the command line tool. Subcommands register themselves from client/commands/.
+#include "client/commands/command.h"
+
+#include <spdlog/spdlog.h>
+
+#include <exception>
+#include <iostream>
+
+int main(int argc, char** argv) {
+  CLI::App app{"rrg - real-time reflection-aware Gaussian SLAM (RRG-SLAM) tools"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "rrg 0.1.0");
+  bool verbose = false;
+  app.add_flag("-v,--verbose", verbose, "debug logging");
+  app.parse_complete_callback([&] { spdlog::set_level(verbose ? spdlog::level::debug : spdlog::level::info); });
+
+  rrg::cli::register_synth_command(app);
+  rrg::cli::register_eval_command(app);
+  rrg::cli::register_dataset_command(app);
+  rrg::cli::register_device_command(app);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const std::exception& e) {
+    std::cerr << "rrg: error: " << e.what() << "\n";
+    return rrg::cli::kExitFailure;
+  }
+  return 0;
+}
