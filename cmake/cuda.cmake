@@ -20,6 +20,10 @@ if(NOT _rrg_cuda STREQUAL "OFF")
     endif()
     enable_language(CUDA)
     find_package(CUDAToolkit REQUIRED)
+    # CMake 3.25 predates nvcc's C++20 support; tell it the flag (nvcc >= 12 accepts -std=c++20).
+    set(CMAKE_CUDA20_STANDARD_COMPILE_OPTION "-std=c++20")
+    set(CMAKE_CUDA20_EXTENSION_COMPILE_OPTION "-std=c++20")
+    list(APPEND CMAKE_CUDA_COMPILE_FEATURES cuda_std_20)
     set(CMAKE_CUDA_STANDARD 20)
     set(CMAKE_CUDA_STANDARD_REQUIRED ON)
     # Extended lambdas let one [=] RRG_HD (int64_t i) body run on both back ends; 20012 and

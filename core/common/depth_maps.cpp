@@ -1,0 +1,23 @@
+#include "core/common/depth_maps.h"
+
+#include "core/common/depth_maps_impl.h"
+#include "core/common/dispatch.h"
+
+#include <stdexcept>
+
+namespace rrg {
+
+VertexNormalMaps compute_vertex_normal_maps(const DeviceImage<float>& depth, const Intrinsics& K) {
+  if (depth.width() != K.width || depth.height() != K.height)
+    throw std::invalid_argument("compute_vertex_normal_maps: depth is " + std::to_string(depth.width()) +
+                                "x" + std::to_string(depth.height()) + " but intrinsics are " +
+                                K.to_string());
+  const Device& dev = depth.device();
+  VertexNormalMaps maps{DeviceImage<Eigen::Vector3f>(depth.width(), depth.height(), dev),
+                        DeviceImage<Eigen::Vector3f>(depth.width(), depth.height(), dev)};
+  RRG_DISPATCH(dev, kernel::vertex_normal_maps_cpu(depth.view(), K, maps.vertices.view(), maps.normals.view()),
+               kernel::vertex_normal_maps_cuda(depth.view(), K, maps.vertices.view(), maps.normals.view()));
+  return maps;
+}
+
+}  // namespace rrg

@@ -1,0 +1,12 @@
+#include "core/common/depth_maps_impl.h"
+#include "core/common/parallel_for_cuda.cuh"
+
+namespace rrg::kernel {
+
+void vertex_normal_maps_cuda(ImageView<const float> depth, const Intrinsics& K,
+                             ImageView<Eigen::Vector3f> vertices, ImageView<Eigen::Vector3f> normals) {
+  vertex_normal_maps(CudaBackend{}, depth, K, vertices, normals);
+  RRG_CUDA_CHECK(cudaStreamSynchronize(nullptr));
+}
+
+}  // namespace rrg::kernel
