@@ -19,8 +19,10 @@ DepthImage plane_depth(const Eigen::Vector3f& n, float d) {
 
 std::vector<float> flatten(const VertexNormalMaps& m) {
   std::vector<float> out;
-  for (const auto* img : {&m.vertices, &m.normals})
-    for (const auto& v : img->to_host().pixels()) out.insert(out.end(), {v.x(), v.y(), v.z()});
+  for (const auto* img : {&m.vertices, &m.normals}) {
+    const auto host = img->to_host();  // named: a temporary's pixels() would dangle in the loop
+    for (const auto& v : host.pixels()) out.insert(out.end(), {v.x(), v.y(), v.z()});
+  }
   return out;
 }
 

@@ -1,0 +1,33 @@
+// Vertex + normal maps (paper §4.1.1) at 640x480 on every available device, host<->device copies
+// excluded (the pipeline keeps frames on the device). Reports ms per frame and frames/s.
+#include "core/common/depth_maps.h"
+
+#include <benchmark/benchmark.h>
+
+namespace {
+
+void BM_VertexNormalMaps(benchmark::State& state, rrg::Device device) {
+  const rrg::Intrinsics K{525.0f, 525.0f, 319.5f, 239.5f, 640, 480};
+  rrg::DepthImage depth(640, 480);
+  for (int y = 0; y < 480; ++y)
+    for (int x = 0; x < 640; ++x) depth(x, y) = 1.0f + 0.002f * x + 0.001f * y;
+  const auto d = rrg::DeviceImage<float>::from_host(depth, device);
+  for (auto _ : state) {
+    auto maps = rrg::compute_vertex_normal_maps(d, K);
+    benchmark::DoNotOptimize(maps.normals.buffer().data());
+  }
+  state.counters["fps"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+}
+
+const bool registered = [] {
+  for (const rrg::Device& device : rrg::available_devices())
+    benchmark::RegisterBenchmark(("vertex_normal_maps_640x480/" + device.to_string()).c_str(),
+                                 BM_VertexNormalMaps, device)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+  return true;
+}();
+
+}  // namespace
+
+BENCHMARK_MAIN();
