@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   rrg::cli::register_eval_command(app);
   rrg::cli::register_dataset_command(app);
   rrg::cli::register_device_command(app);
+  rrg::cli::register_fuse_command(app);
 
   try {
     app.parse(argc, argv);

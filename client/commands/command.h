@@ -12,5 +12,6 @@ void register_synth_command(CLI::App& app);    // rrg synth
 void register_eval_command(CLI::App& app);     // rrg eval ate|images|mesh
 void register_dataset_command(CLI::App& app);  // rrg dataset info
 void register_device_command(CLI::App& app);   // rrg devices
+void register_fuse_command(CLI::App& app);     // rrg fuse (TSDF from a posed dataset -> mesh)
 
 }  // namespace rrg::cli

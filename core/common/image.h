@@ -38,7 +38,8 @@ class Image {
   std::span<T> pixels() { return data_; }
   std::span<const T> pixels() const { return data_; }
 
-  bool same_size(const Image& o) const { return width_ == o.width_ && height_ == o.height_; }
+  template <class U>
+  bool same_size(const Image<U>& o) const { return width_ == o.width() && height_ == o.height(); }
 
  private:
   int width_ = 0;

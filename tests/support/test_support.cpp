@@ -24,6 +24,8 @@ TempDir::~TempDir() {
 }
 
 CommandResult run_rrg(const std::string& args) {
+  if (!std::filesystem::exists(RRG_CLI))
+    throw std::runtime_error(std::string("the rrg executable is not built: ") + RRG_CLI);
   const std::string cmd = std::string(RRG_CLI) + " " + args + " 2>&1";
   FILE* pipe = ::popen(cmd.c_str(), "r");
   if (!pipe) throw std::runtime_error("popen failed for: " + cmd);
