@@ -1,12 +1,15 @@
 // rrg: the command line tool. Subcommands register themselves from client/commands/.
 #include "client/commands/command.h"
 
+#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include <exception>
 #include <iostream>
 
 int main(int argc, char** argv) {
+  // Logs go to stderr so that stdout carries only results (tables, --json).
+  spdlog::set_default_logger(spdlog::stderr_color_mt("rrg"));
   CLI::App app{"rrg - real-time reflection-aware Gaussian SLAM (RRG-SLAM) tools"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "rrg 0.1.0");
@@ -23,7 +26,8 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    const int code = app.exit(e);  // prints help / version / the usage error
+    return code == 0 ? 0 : rrg::cli::kExitUsage;
   } catch (const std::exception& e) {
     std::cerr << "rrg: error: " << e.what() << "\n";
     return rrg::cli::kExitFailure;

@@ -5,8 +5,9 @@
 
 namespace rrg::cli {
 
-// Exit codes: 0 ok, 1 runtime failure (bad data, I/O), 2 usage error (bad flags; CLI11's own).
+// Exit codes: 0 ok, 1 runtime failure (bad data, I/O), 2 usage error (bad or missing flags).
 inline constexpr int kExitFailure = 1;
+inline constexpr int kExitUsage = 2;
 
 void register_synth_command(CLI::App& app);    // rrg synth
 void register_eval_command(CLI::App& app);     // rrg eval ate|images|mesh

@@ -2,6 +2,7 @@
 // One interface for every RGB-D sequence we read: TUM RGB-D, 7-Scenes/3DMatch, Replica (NICE-SLAM
 // layout) and our synthetic layout (TUM plus extras, see docs/datasets.md). Frames load lazily;
 // intrinsics and depth scale come from a file in the folder when present, else from the options.
+// Synth extras (labels, reflection masks, plane ids): core/io/synth_layout.h.
 #include "core/common/camera.h"
 #include "core/common/image.h"
 #include "core/io/trajectory.h"
@@ -26,7 +27,8 @@ std::string to_string(DatasetFormat format);
 
 struct DatasetOptions {
   DatasetFormat format = DatasetFormat::Auto;
-  // Overrides, used when the folder has no calibration file (and always when force_* is set).
+  // Used when the folder has no calibration file (camera.json, camera-intrinsics.txt,
+  // cam_params.json); a calibration file wins, with a warning.
   std::optional<Intrinsics> intrinsics;   // --intrinsics fx,fy,cx,cy or a name (freiburg1|2|3, replica, 7scenes)
   std::optional<float> depth_scale;       // --depth-scale S (depth units per metre)
   double max_time_difference = 0.02;      // TUM association, seconds (as associate.py)
