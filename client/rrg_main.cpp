@@ -22,6 +22,8 @@ int main(int argc, char** argv) {
   rrg::cli::register_dataset_command(app);
   rrg::cli::register_device_command(app);
   rrg::cli::register_fuse_command(app);
+  rrg::cli::register_track_command(app);
+  rrg::cli::register_planes_command(app);
 
   try {
     app.parse(argc, argv);

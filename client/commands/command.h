@@ -14,5 +14,7 @@ void register_eval_command(CLI::App& app);     // rrg eval ate|images|mesh
 void register_dataset_command(CLI::App& app);  // rrg dataset info
 void register_device_command(CLI::App& app);   // rrg devices
 void register_fuse_command(CLI::App& app);     // rrg fuse (TSDF from a posed dataset -> mesh)
+void register_track_command(CLI::App& app);    // rrg track (tracking + TSDF fusion on a dataset)
+void register_planes_command(CLI::App& app);   // rrg planes (reflective plane identification)
 
 }  // namespace rrg::cli
