@@ -4,6 +4,7 @@
 #include "core/common/hd.h"
 
 #include <cstdint>
+#include <type_traits>
 
 namespace rrg {
 
@@ -14,7 +15,11 @@ struct Span {
 
   RRG_HD T& operator[](int64_t i) const { return data[i]; }
   RRG_HD bool empty() const { return size == 0; }
-  RRG_HD operator Span<const T>() const { return {data, size}; }
+  RRG_HD operator Span<const T>() const
+    requires(!std::is_const_v<T>)
+  {
+    return {data, size};
+  }
 };
 
 template <class T>
@@ -27,7 +32,11 @@ struct ImageView {
   RRG_HD T& operator[](int64_t i) const { return data[i]; }
   RRG_HD int64_t size() const { return int64_t(width) * height; }
   RRG_HD bool contains(int x, int y) const { return x >= 0 && y >= 0 && x < width && y < height; }
-  RRG_HD operator ImageView<const T>() const { return {data, width, height}; }
+  RRG_HD operator ImageView<const T>() const
+    requires(!std::is_const_v<T>)
+  {
+    return {data, width, height};
+  }
 };
 
 }  // namespace rrg

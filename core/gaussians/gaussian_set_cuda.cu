@@ -1,0 +1,11 @@
+#include "core/common/parallel_for_cuda.cuh"
+#include "core/gaussians/gaussian_set_impl.h"
+
+namespace rrg::kernel {
+
+void move_words_cuda(Span<uint32_t> data, int words, Span<const int32_t> src, Span<const int32_t> dst) {
+  move_words(CudaBackend{}, data, words, src, dst);
+  RRG_CUDA_CHECK(cudaStreamSynchronize(nullptr));
+}
+
+}  // namespace rrg::kernel

@@ -1,0 +1,178 @@
+#pragma once
+// One splat at one pixel, for pass 2 (base, sort-free weighted sum with the depth cull) and pass 3
+// (reflection, front-to-back alpha compositing with the plane test): forward and backward, the only
+// copy of the math. Used by the CPU loop and by the CUDA kernels alike.
+#include "core/render/splat.h"
+
+namespace rrg::kernel {
+
+inline constexpr float kAlphaMin = 1.0f / 255.0f;    // smaller alphas are skipped (3DGS)
+inline constexpr float kAlphaMax = 0.99f;            // pass-3 alphas are clamped here (3DGS)
+inline constexpr float kTransmittanceMin = 1e-4f;    // pass 3 stops before T drops below this
+// Exponents below ln(kAlphaMin) - 1e-3 give alpha < kAlphaMin for any opacity <= 1: rejected
+// before the exp (an exact shortcut, not a new threshold).
+inline constexpr float kPowerMin = -5.5422645f;
+
+// alpha_i(u) = min(sigma_i exp(-1/2 (u - p_hat)^T Sigma'^-1 (u - p_hat)), alpha_max), or 0 when
+// below kAlphaMin (or the exponent is positive, as in 3DGS).
+template <class T>
+RRG_HD inline T splat_alpha(const SplatT<T>& s, T px, T py, T alpha_max) {
+  const T dx = s.mean[0] - px, dy = s.mean[1] - py;
+  const T power = T(-0.5) * (s.conic[0] * dx * dx + s.conic[2] * dy * dy) - s.conic[1] * dx * dy;
+  if (power > T(0) || power < T(kPowerMin)) return T(0);
+  T alpha = s.opacity * k_exp(power);
+  if (alpha > alpha_max) alpha = alpha_max;
+  return alpha < T(kAlphaMin) ? T(0) : alpha;
+}
+
+// v += d alpha / d(splat) * v_alpha, for an alpha splat_alpha returned non-zero.
+template <class T>
+RRG_HD inline void splat_alpha_bwd(const SplatT<T>& s, T px, T py, T alpha_max, T v_alpha, SplatT<T>& v) {
+  const T dx = s.mean[0] - px, dy = s.mean[1] - py;
+  const T power = T(-0.5) * (s.conic[0] * dx * dx + s.conic[2] * dy * dy) - s.conic[1] * dx * dy;
+  const T G = k_exp(power);
+  if (s.opacity * G > alpha_max) return;  // clamped: constant
+  v.opacity += G * v_alpha;
+  const T v_power = s.opacity * G * v_alpha;
+  v.conic[0] += T(-0.5) * dx * dx * v_power;
+  v.conic[1] += -dx * dy * v_power;
+  v.conic[2] += T(-0.5) * dy * dy * v_power;
+  v.mean[0] += -(s.conic[0] * dx + s.conic[1] * dy) * v_power;
+  v.mean[1] += -(s.conic[1] * dx + s.conic[2] * dy) * v_power;
+}
+
+// ---- pass 2: A_b[x](u) = sum_i 1(d_i < D_t(u) + eps) alpha_i(u) x_i --------------------------
+
+template <class T>
+struct BaseAccumT {
+  Vec3<T> C_g = Vec3<T>::Zero();  // A_b[c]
+  T W_g = T(0);                   // A_b[1]
+  T D_g = T(0);                   // A_b[d]
+};
+
+// The depth cull. Where the raycast missed (D_t = 0) there is no surface to cull against.
+template <class T>
+RRG_HD inline bool base_visible(const SplatT<T>& s, T D_t, T eps) {
+  return !(D_t > T(0)) || s.depth < D_t + eps;
+}
+
+// Adds splat s at pixel (px, py); returns its alpha (0 when culled or negligible).
+template <class T>
+RRG_HD inline T base_accumulate(BaseAccumT<T>& acc, const SplatT<T>& s, T px, T py, T D_t, T eps) {
+  if (!base_visible(s, D_t, eps)) return T(0);
+  const T alpha = splat_alpha(s, px, py, T(1));
+  if (alpha == T(0)) return T(0);
+  acc.C_g += alpha * Vec3<T>(s.color[0], s.color[1], s.color[2]);
+  acc.W_g += alpha;
+  acc.D_g += alpha * s.depth;
+  return alpha;
+}
+
+// Denominator of the base composite: 1 + W_g on a raycast hit; max(1, W_g) on a miss, where the
+// TSDF term has no weight (C_t = 0, D_t = 0) and the Gaussians alone give C_b and D_b.
+template <class T>
+RRG_HD inline T base_denominator(T W_g, T D_t) {
+  if (D_t > T(0)) return T(1) + W_g;
+  return W_g > T(1) ? W_g : T(1);
+}
+
+// C_b = (C_t + C_g) / (1 + W_g), D_b = (D_t + D_g) / (1 + W_g) (misses: see base_denominator).
+template <class T>
+RRG_HD inline void base_resolve(const BaseAccumT<T>& acc, const Vec3<T>& C_t, T D_t, Vec3<T>& C_b, T& D_b) {
+  const T den = base_denominator(acc.W_g, D_t);
+  const bool hit = D_t > T(0);
+  C_b = ((hit ? C_t : Vec3<T>::Zero()) + acc.C_g) / den;
+  D_b = ((hit ? D_t : T(0)) + acc.D_g) / den;
+}
+
+// Upstream gradients of the accumulators from v_C_b, v_D_b.
+template <class T>
+struct BaseUpstreamT {
+  Vec3<T> v_C_g;
+  T v_W_g, v_D_g;
+};
+
+template <class T>
+RRG_HD inline BaseUpstreamT<T> base_resolve_bwd(T W_g, T D_t, const Vec3<T>& C_b, T D_b, const Vec3<T>& v_C_b,
+                                                T v_D_b) {
+  const T den = base_denominator(W_g, D_t);
+  BaseUpstreamT<T> u;
+  u.v_C_g = v_C_b / den;
+  u.v_D_g = v_D_b / den;
+  const bool den_varies = D_t > T(0) || W_g > T(1);
+  u.v_W_g = den_varies ? -(v_C_b.dot(C_b) + v_D_b * D_b) / den : T(0);
+  return u;
+}
+
+// Gradient of splat s's contribution at (px, py) into v.
+template <class T>
+RRG_HD inline void base_splat_bwd(const SplatT<T>& s, T px, T py, T D_t, T eps, const BaseUpstreamT<T>& u,
+                                  SplatT<T>& v) {
+  if (!base_visible(s, D_t, eps)) return;
+  const T alpha = splat_alpha(s, px, py, T(1));
+  if (alpha == T(0)) return;
+  const Vec3<T> c(s.color[0], s.color[1], s.color[2]);
+  const T v_alpha = u.v_C_g.dot(c) + u.v_W_g + u.v_D_g * s.depth;
+  for (int ch = 0; ch < 3; ++ch) v.color[ch] += alpha * u.v_C_g[ch];
+  v.depth += alpha * u.v_D_g;
+  splat_alpha_bwd(s, px, py, T(1), v_alpha, v);
+}
+
+// ---- pass 3: A_r[x](u) = sum_i prod_{j<i} (1 - alpha_j) alpha_i x_i, alpha with 1(l_i == I(u)) ------
+
+template <class T>
+struct ReflStateT {
+  T trans = T(1);                 // T: transmittance so far
+  Vec3<T> C = Vec3<T>::Zero();    // C_r so far (in the backward pass: the prefix P_i)
+  T W = T(0);                     // W_r so far
+};
+
+// Composites splat s (already known to pass the plane test) behind the current state. Returns false
+// when the pixel is saturated (T would drop below kTransmittanceMin; s is then not added).
+template <class T>
+RRG_HD inline bool refl_step(ReflStateT<T>& st, const SplatT<T>& s, T px, T py) {
+  const T alpha = splat_alpha(s, px, py, T(kAlphaMax));
+  if (alpha == T(0)) return true;
+  const T next = st.trans * (T(1) - alpha);
+  if (next < T(kTransmittanceMin)) return false;
+  const T w = alpha * st.trans;
+  st.C += w * Vec3<T>(s.color[0], s.color[1], s.color[2]);
+  st.W += w;
+  st.trans = next;
+  return true;
+}
+
+// Backward of refl_step, replayed front to back with the final C_r, W_r of the pixel:
+// dC/dalpha_i = T_i c_i - (C - P_i) / (1 - alpha_i), P_i the colour up to and including i.
+template <class T>
+RRG_HD inline bool refl_step_bwd(ReflStateT<T>& st, const SplatT<T>& s, T px, T py, const Vec3<T>& C_final,
+                                 T W_final, const Vec3<T>& v_C, T v_W, SplatT<T>& v) {
+  const T alpha = splat_alpha(s, px, py, T(kAlphaMax));
+  if (alpha == T(0)) return true;
+  const T next = st.trans * (T(1) - alpha);
+  if (next < T(kTransmittanceMin)) return false;
+  const Vec3<T> c(s.color[0], s.color[1], s.color[2]);
+  const T w = alpha * st.trans;
+  st.C += w * c;
+  st.W += w;
+  const T inv = T(1) / (T(1) - alpha);
+  const T v_alpha = v_C.dot(st.trans * c - (C_final - st.C) * inv) + v_W * (st.trans - (W_final - st.W) * inv);
+  for (int ch = 0; ch < 3; ++ch) v.color[ch] += w * v_C[ch];
+  splat_alpha_bwd(s, px, py, T(kAlphaMax), v_alpha, v);
+  st.trans = next;
+  return true;
+}
+
+// ---- pixels in tile-major order: a warp / a thread's chunk stays inside one tile -------------------
+
+// Slot i -> pixel (x, y) and its tile; false for slots past the image edge.
+RRG_HD inline bool tile_pixel(int64_t i, int width, int height, int tiles_x, int& x, int& y, int& tile) {
+  constexpr int kTilePixels = kTileSize * kTileSize;
+  tile = int(i / kTilePixels);
+  const int local = int(i % kTilePixels);
+  x = (tile % tiles_x) * kTileSize + local % kTileSize;
+  y = (tile / tiles_x) * kTileSize + local / kTileSize;
+  return x < width && y < height;
+}
+
+}  // namespace rrg::kernel

@@ -1,0 +1,112 @@
+#pragma once
+// Projection, tile binning and the projection backward, templated on the back end; instantiated by
+// project_cpu.cpp and project_cuda.cu.
+#include "core/common/atomics.h"
+#include "core/render/project_device.h"
+#include "core/render/stage_args.h"
+
+#include <cstring>
+
+namespace rrg::kernel {
+
+template <class S>
+RRG_HD inline GaussianInT<float, S> gaussian_at(const GaussianViews& g, int64_t i, int stride) {
+  return {g.means[i], g.log_scales[i], g.quats[i], g.logit_opacities[i], &g.sh[i * stride]};
+}
+
+// splats[i], rects[i] for every Gaussian; culled ones get an empty rect.
+template <class Backend>
+void project_splats(Backend b, View view, GaussianViews g, Span<Splat> splats, Span<TileRect> rects) {
+  parallel_for(b, g.means.size, [=] RRG_HD(int64_t i) {
+    const auto gi = gaussian_at<Eigen::Vector3f>(g, i, view.sh_stride);
+    Splat s{};
+    float radius = 0;
+    if (!project_gaussian<float, Eigen::Vector3f>(view, gi, s, radius)) {
+      splats[i] = s;
+      rects[i] = TileRect{};
+      return;
+    }
+    splats[i] = s;
+    rects[i] = tile_rect(view, s, radius);
+  });
+}
+
+// counts[i] = tiles touched by Gaussian i, 0 unless plane < 0 or plane_ids[i] == plane.
+template <class Backend>
+void count_tiles(Backend b, Span<const TileRect> rects, Span<const int32_t> plane_ids, int32_t plane,
+                 Span<int32_t> counts) {
+  parallel_for(b, rects.size, [=] RRG_HD(int64_t i) {
+    counts[i] = (plane < 0 || plane_ids[i] == plane) ? rects[i].count() : 0;
+  });
+}
+
+// Key of an entry: tile id in the high 32 bits, and with_depth the depth's float bits (positive
+// floats order as their bits) in the low 32; value: the Gaussian index.
+template <class Backend>
+void write_keys(Backend b, int tiles_x, Span<const TileRect> rects, Span<const Splat> splats,
+                Span<const int32_t> counts, Span<const int32_t> offsets, bool with_depth,
+                Span<uint64_t> keys, Span<int32_t> values) {
+  parallel_for(b, rects.size, [=] RRG_HD(int64_t i) {
+    if (counts[i] == 0) return;
+    const TileRect r = rects[i];
+    uint32_t depth_bits = 0;
+    if (with_depth) {
+      const float d = splats[i].depth;
+      memcpy(&depth_bits, &d, sizeof(float));
+    }
+    int64_t at = offsets[i];
+    for (int ty = r.y0; ty < r.y1; ++ty)
+      for (int tx = r.x0; tx < r.x1; ++tx, ++at) {
+        const uint64_t tile = uint64_t(ty) * uint64_t(tiles_x) + uint64_t(tx);
+        keys[at] = with_depth ? (tile << 32) | depth_bits : tile;
+        values[at] = int32_t(i);
+      }
+  });
+}
+
+// ranges[t] = [begin, end) of tile t in sorted keys (ranges zeroed beforehand).
+template <class Backend>
+void tile_ranges(Backend b, Span<const uint64_t> keys, bool with_depth, Span<TileRange> ranges) {
+  const int64_t n = keys.size;
+  parallel_for(b, n, [=] RRG_HD(int64_t i) {
+    const int shift = with_depth ? 32 : 0;
+    const int32_t tile = int32_t(keys[i] >> shift);
+    if (i == 0 || int32_t(keys[i - 1] >> shift) != tile) ranges[tile].begin = int32_t(i);
+    if (i == n - 1 || int32_t(keys[i + 1] >> shift) != tile) ranges[tile].end = int32_t(i + 1);
+  });
+}
+
+// Gradients of every Gaussian parameter from its splat gradient.
+template <class Backend>
+void project_bwd(Backend b, View view, GaussianViews g, Span<const SplatGrad> v_splats, GaussianGradViews v) {
+  parallel_for(b, g.means.size, [=] RRG_HD(int64_t i) {
+    const auto gi = gaussian_at<Eigen::Vector3f>(g, i, view.sh_stride);
+    Vec3<float> v_sh_local[kMaxShCoeffs];
+    for (int k = 0; k < kMaxShCoeffs; ++k) v_sh_local[k].setZero();
+    Vec3<float> v_mean, v_log_scale;
+    Vec4<float> v_quat;
+    float v_logit = 0;
+    project_gaussian_bwd<float, Eigen::Vector3f>(view, gi, v_splats[i], v_mean, v_log_scale, v_quat, v_logit,
+                                                 v_sh_local);
+    v.v_means[i] = v_mean;
+    v.v_log_scales[i] = v_log_scale;
+    v.v_quats[i] = v_quat;
+    v.v_logit_opacities[i] = v_logit;
+    for (int k = 0; k < view.sh_stride; ++k) v.v_sh[i * view.sh_stride + k] = v_sh_local[k];
+  });
+}
+
+void project_splats_cpu(View view, GaussianViews g, Span<Splat> splats, Span<TileRect> rects);
+void project_splats_cuda(View view, GaussianViews g, Span<Splat> splats, Span<TileRect> rects);
+void count_tiles_cpu(Span<const TileRect> rects, Span<const int32_t> plane_ids, int32_t plane, Span<int32_t> counts);
+void count_tiles_cuda(Span<const TileRect> rects, Span<const int32_t> plane_ids, int32_t plane, Span<int32_t> counts);
+void write_keys_cpu(int tiles_x, Span<const TileRect> rects, Span<const Splat> splats, Span<const int32_t> counts,
+                    Span<const int32_t> offsets, bool with_depth, Span<uint64_t> keys, Span<int32_t> values);
+void write_keys_cuda(int tiles_x, Span<const TileRect> rects, Span<const Splat> splats, Span<const int32_t> counts,
+                     Span<const int32_t> offsets, bool with_depth, Span<uint64_t> keys, Span<int32_t> values);
+void tile_ranges_cpu(Span<const uint64_t> keys, bool with_depth, Span<TileRange> ranges);
+void tile_ranges_cuda(Span<const uint64_t> keys, bool with_depth, Span<TileRange> ranges);
+void project_bwd_cpu(View view, GaussianViews g, Span<const SplatGrad> v_splats, GaussianGradViews v);
+void project_bwd_cuda(View view, GaussianViews g, Span<const SplatGrad> v_splats, GaussianGradViews v);
+
+}  // namespace rrg::kernel

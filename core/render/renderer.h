@@ -1,0 +1,74 @@
+#pragma once
+// The reflection-aware Gaussian renderer, passes 2 and 3 of paper §3.2 with their backward passes,
+// on the device the data lives on (CPU or CUDA, same source):
+//   pass 2  C_g, W_g, D_g = A_b[c], A_b[1], A_b[d]   (sort-free, depth cull d_i < D_t(u) + eps)
+//           C_b = (C_t + C_g) / (1 + W_g),  D_b = (D_t + D_g) / (1 + W_g)
+//   pass 3  C_r, W_r = A_r[c], A_r[1]                (per-tile depth sort, alpha compositing,
+//                                                     Gaussian i only where l_i == I(u))
+//           C = C_b + R C_r
+// Where the raycast missed (D_t = 0) there is no depth cull and no TSDF term:
+// C_b = C_g / max(1, W_g), D_b = D_g / max(1, W_g) (docs/render.md).
+// The renderer owns all scratch memory and reuses it across frames.
+#include "core/gaussians/gaussian_grads.h"
+#include "core/gaussians/gaussian_set.h"
+#include "core/render/render_types.h"
+#include "core/render/splat.h"
+#include "core/render/tile_bins.h"
+
+#include <vector>
+
+namespace rrg {
+
+class Renderer {
+ public:
+  explicit Renderer(const Device& device, RenderParams params = {});
+
+  const Device& device() const { return device_; }
+  const RenderParams& params() const { return params_; }
+  void set_params(const RenderParams& params);
+
+  // Renders base set G_b and reflection set G_r (both on device()) over the raycast inputs into
+  // out (resized as needed). Keeps references to camera, sets and inputs for backward(): they must
+  // stay alive and unchanged until then. Throws std::invalid_argument on mismatched sizes/devices.
+  void render(const RenderCamera& camera, const GaussianSet& base, const GaussianSet& reflection,
+              const RaycastInputs& raycast, RenderOutputs& out);
+
+  // Gradients of every parameter of both sets (not the TSDF maps) for the last render(), given
+  // dL/dC, dL/dD_b and optionally dL/dC_r. Overwrites v_base and v_reflection.
+  void backward(const RenderUpstream& upstream, GaussianGrads& v_base, GaussianGrads& v_reflection);
+
+  const RenderTimings& timings() const { return timings_; }
+  // Entries (tile, Gaussian) binned in the last render: base set, reflection set (summed over groups).
+  int64_t base_entries() const { return base_entries_; }
+  int64_t reflection_entries() const { return refl_entries_; }
+
+ private:
+  struct Projected {
+    Buffer<kernel::Splat> splats;
+    Buffer<kernel::TileRect> rects;
+    Buffer<kernel::SplatGrad> v_splats;
+    TileBins bins;
+  };
+  kernel::View make_view(const RenderCamera& camera, const GaussianSet& set) const;
+  void project(const kernel::View& view, const GaussianSet& set, Projected& p);
+  void reflection_forward(const kernel::View& view, RenderOutputs& out);
+  void reflection_backward(const kernel::View& view, const DeviceImage<Color>& v_C_r);
+  std::vector<int32_t> reflection_groups() const;
+
+  Device device_;
+  RenderParams params_;
+  RenderTimings timings_;
+  Projected base_, refl_;
+  int64_t base_entries_ = 0, refl_entries_ = 0;
+  // state of the last render, for backward()
+  RenderCamera camera_;
+  const GaussianSet* base_set_ = nullptr;
+  const GaussianSet* refl_set_ = nullptr;
+  const RaycastInputs* raycast_ = nullptr;
+  const RenderOutputs* out_ = nullptr;
+  // multi-pass scratch images and the combined upstream of C_r
+  DeviceImage<Color> group_C_, v_C_r_;
+  DeviceImage<float> group_W_;
+};
+
+}  // namespace rrg

@@ -1,0 +1,24 @@
+#pragma once
+// Per-Gaussian splat-gradient helpers shared by the backward rasterisers of both back ends.
+#include "core/common/atomics.h"
+#include "core/render/splat.h"
+
+namespace rrg::kernel {
+
+// True when every field is zero (the splat did not touch the pixel).
+RRG_HD inline bool is_zero(const SplatGrad& g) {
+  const float* s = &g.mean[0];
+  for (int k = 0; k < int(sizeof(SplatGrad) / sizeof(float)); ++k)
+    if (s[k] != 0.0f) return false;
+  return true;
+}
+
+// One atomic add per non-zero field into the shared splat gradient.
+RRG_HD inline void atomic_add_grad(SplatGrad* dst, const SplatGrad& g) {
+  float* d = &dst->mean[0];
+  const float* s = &g.mean[0];
+  for (int k = 0; k < int(sizeof(SplatGrad) / sizeof(float)); ++k)
+    if (s[k] != 0.0f) atomic_add(d + k, s[k]);
+}
+
+}  // namespace rrg::kernel

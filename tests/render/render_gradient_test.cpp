@@ -1,0 +1,193 @@
+// Backward passes of pass 2 and pass 3 against central finite differences of the double-precision
+// reference (render_scene.h), per parameter type of each set; CPU/CUDA parity of the gradients.
+#include "core/render/renderer.h"
+#include "tests/render/render_scene.h"
+#include "tests/support/parity.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <iostream>
+#include <string>
+
+namespace rrg::test {
+namespace {
+
+struct Grads {
+  GaussianHost base, refl;  // gradients stored in a GaussianHost layout (v_* per field)
+};
+
+GaussianHost to_host_grads(const GaussianGrads& g, int degree) {
+  GaussianHost h(degree);
+  h.means = g.v_means.to_host();
+  h.log_scales = g.v_log_scales.to_host();
+  h.quats = g.v_quats.to_host();
+  h.logit_opacities = g.v_logit_opacities.to_host();
+  h.sh = g.v_sh.to_host();
+  h.plane_ids.assign(h.means.size(), 0);
+  return h;
+}
+
+Grads analytic(const SmallScene& s, const HostUpstream& up, const RenderParams& p, const Device& device) {
+  const auto base = GaussianSet::from_host(s.base, device);
+  const auto refl = GaussianSet::from_host(s.refl, device);
+  const auto in = to_device(s.raycast, device);
+  Renderer r(device, p);
+  RenderOutputs out;
+  r.render(s.camera, base, refl, in, out);
+  GaussianGrads gb, gr;
+  r.backward(to_device(up, device), gb, gr);
+  return {to_host_grads(gb, s.base.sh_degree), to_host_grads(gr, s.refl.sh_degree)};
+}
+
+enum class Param { Mean, LogScale, Quat, Opacity, Sh };
+const char* name(Param p) {
+  switch (p) {
+    case Param::Mean: return "means";
+    case Param::LogScale: return "log_scales";
+    case Param::Quat: return "quats";
+    case Param::Opacity: return "logit_opacities";
+    case Param::Sh: return "sh";
+  }
+  return "?";
+}
+
+// Pointers to every scalar of one parameter type in a double set, and the matching analytic values.
+void scalars(GaussiansD& g, const GaussianHost& a, Param p, std::vector<double*>& x, std::vector<double>& grad) {
+  for (size_t i = 0; i < g.means.size(); ++i) switch (p) {
+      case Param::Mean:
+        for (int k = 0; k < 3; ++k) x.push_back(&g.means[i][k]), grad.push_back(a.means[i][k]);
+        break;
+      case Param::LogScale:
+        for (int k = 0; k < 3; ++k) x.push_back(&g.log_scales[i][k]), grad.push_back(a.log_scales[i][k]);
+        break;
+      case Param::Quat:
+        for (int k = 0; k < 4; ++k) x.push_back(&g.quats[i][k]), grad.push_back(a.quats[i][k]);
+        break;
+      case Param::Opacity:
+        x.push_back(&g.logit_opacities[i]), grad.push_back(a.logit_opacities[i]);
+        break;
+      case Param::Sh:
+        break;
+    }
+  if (p == Param::Sh)
+    for (size_t j = 0; j < g.sh.size(); ++j)
+      for (int k = 0; k < 3; ++k) x.push_back(&g.sh[j][k]), grad.push_back(a.sh[j][k]);
+}
+
+struct CheckResult {
+  double max_rel = 0;   // max |analytic - fd| / max |fd| over the parameter type
+  double max_abs_fd = 0;
+  size_t n = 0;
+  size_t at_threshold = 0;  // scalars skipped: the loss jumps within +-h (a 3DGS threshold crossed)
+};
+
+// Central differences (h = 1e-6, double) of the reference loss w.r.t. one parameter type of one set.
+// The renderer is piecewise smooth (alpha < 1/255 skipped, early termination, depth cull, integer
+// radii); where the two one-sided differences disagree grossly a threshold lies inside +-h, the
+// derivative there is not defined, and the scalar is skipped (at most 2% may be).
+CheckResult check(const SmallScene& s, const HostUpstream& up, const RenderParams& p, const Grads& a, bool refl_set,
+                  Param param) {
+  GaussiansD base = GaussiansD::from(s.base), refl = GaussiansD::from(s.refl);
+  std::vector<double*> x;
+  std::vector<double> grad;
+  scalars(refl_set ? refl : base, refl_set ? a.refl : a.base, param, x, grad);
+  const double h = 1e-6;
+  const double l0 = reference_loss(render_reference(s.camera, base, refl, s.raycast, p), up);
+  std::vector<double> fd(x.size());
+  std::vector<bool> smooth(x.size(), true);
+  CheckResult r;
+  r.n = x.size();
+  for (size_t j = 0; j < x.size(); ++j) {
+    const double x0 = *x[j];
+    *x[j] = x0 + h;
+    const double lp = reference_loss(render_reference(s.camera, base, refl, s.raycast, p), up);
+    *x[j] = x0 - h;
+    const double lm = reference_loss(render_reference(s.camera, base, refl, s.raycast, p), up);
+    *x[j] = x0;
+    fd[j] = (lp - lm) / (2 * h);
+    const double fwd = (lp - l0) / h, bwd = (l0 - lm) / h;
+    if (std::abs(fwd - bwd) > 1e-2 * (1.0 + std::abs(fd[j]))) {
+      smooth[j] = false;
+      ++r.at_threshold;
+    }
+  }
+  EXPECT_LE(r.at_threshold, std::max<size_t>(1, x.size() / 50));
+  for (size_t j = 0; j < x.size(); ++j)
+    if (smooth[j]) r.max_abs_fd = std::max(r.max_abs_fd, std::abs(fd[j]));
+  for (size_t j = 0; j < x.size(); ++j) {
+    if (!smooth[j]) continue;
+    const double err = std::abs(grad[j] - fd[j]) / r.max_abs_fd;
+    if (err > r.max_rel) r.max_rel = err;
+    EXPECT_LT(err, 2e-3) << name(param) << "[" << j << "]: analytic " << grad[j] << " vs fd " << fd[j];
+  }
+  return r;
+}
+
+struct Case {
+  uint32_t seed;
+  ReflectionVariant variant;
+};
+
+class RenderGradient : public ::testing::TestWithParam<Case> {};
+
+TEST_P(RenderGradient, EveryParameterTypeOfBothSetsMatchesFiniteDifferences) {
+  const SmallScene s = small_scene(GetParam().seed);
+  const HostUpstream up = random_upstream(s.camera.K.width, s.camera.K.height, GetParam().seed + 1);
+  RenderParams p;
+  p.variant = GetParam().variant;
+  const Grads a = analytic(s, up, p, Device::cpu());
+  for (bool refl_set : {false, true})
+    for (Param param : {Param::Mean, Param::LogScale, Param::Quat, Param::Opacity, Param::Sh}) {
+      SCOPED_TRACE(std::string(refl_set ? "G_r " : "G_b ") + name(param));
+      const CheckResult r = check(s, up, p, a, refl_set, param);
+      EXPECT_GT(r.max_abs_fd, 1e-3) << "the scene must exercise this parameter";
+      std::cout << "[grad] " << to_string(p.variant) << " seed " << GetParam().seed << (refl_set ? " G_r " : " G_b ")
+                << name(param) << ": max rel err " << r.max_rel << " (" << r.n << " scalars, " << r.at_threshold
+                << " at a threshold, max |g| " << r.max_abs_fd << ")\n";
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, RenderGradient,
+                         ::testing::Values(Case{11, ReflectionVariant::Grouped}, Case{23, ReflectionVariant::Grouped},
+                                           Case{11, ReflectionVariant::NoPlaneGrouping},
+                                           Case{11, ReflectionVariant::MultiPass}));
+
+std::vector<float> flatten(const Grads& g) {
+  std::vector<float> v;
+  for (const GaussianHost* h : {&g.base, &g.refl}) {
+    for (const auto& m : h->means) v.insert(v.end(), m.data(), m.data() + 3);
+    for (const auto& m : h->log_scales) v.insert(v.end(), m.data(), m.data() + 3);
+    for (const auto& m : h->quats) v.insert(v.end(), m.data(), m.data() + 4);
+    v.insert(v.end(), h->logit_opacities.begin(), h->logit_opacities.end());
+    for (const auto& m : h->sh) v.insert(v.end(), m.data(), m.data() + 3);
+  }
+  return v;
+}
+
+TEST(RenderGradient, MultiPassGradientsEqualGroupedGradients) {
+  const SmallScene s = small_scene(5);
+  const HostUpstream up = random_upstream(s.camera.K.width, s.camera.K.height, 6);
+  RenderParams p;
+  const auto grouped = flatten(analytic(s, up, p, Device::cpu()));
+  p.variant = ReflectionVariant::MultiPass;
+  const auto multi = flatten(analytic(s, up, p, Device::cpu()));
+  ASSERT_EQ(grouped.size(), multi.size());
+  for (size_t i = 0; i < grouped.size(); ++i) ASSERT_NEAR(grouped[i], multi[i], 1e-5 + 1e-5 * std::abs(grouped[i])) << i;
+}
+
+TEST(RenderGradient, BackwardParityOnEveryDevice) {
+  const SmallScene s = small_scene(31, 80, 56);
+  const HostUpstream up = random_upstream(80, 56, 32);
+  for (auto variant : {ReflectionVariant::Grouped, ReflectionVariant::NoPlaneGrouping, ReflectionVariant::MultiPass}) {
+    SCOPED_TRACE(to_string(variant));
+    RenderParams p;
+    p.variant = variant;
+    // atomics sum in a different order on each device: float tolerance
+    expect_device_parity<float>([&](const Device& d) { return flatten(analytic(s, up, p, d)); }, 1e-4, 1e-3);
+  }
+}
+
+}  // namespace
+}  // namespace rrg::test
