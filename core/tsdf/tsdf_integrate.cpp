@@ -1,0 +1,73 @@
+#include "core/tsdf/tsdf_integrate.h"
+
+#include "core/common/depth_maps.h"
+#include "core/common/dispatch.h"
+#include "core/tsdf/tsdf_integrate_impl.h"
+
+#include <stdexcept>
+#include <string>
+
+namespace rrg {
+namespace {
+
+template <class T>
+void check_image(const DeviceImage<T>& image, const char* what, const Intrinsics& K, const Device& device) {
+  if (image.width() != K.width || image.height() != K.height)
+    throw std::invalid_argument(std::string("integrate: ") + what + " is " + std::to_string(image.width()) + "x" +
+                                std::to_string(image.height()) + " but intrinsics are " + K.to_string());
+  if (!(image.device() == device))
+    throw std::invalid_argument(std::string("integrate: ") + what + " is on " + image.device().to_string() +
+                                " but the volume is on " + device.to_string());
+}
+
+template <class ColorT>
+int64_t integrate_any(TsdfVolume& volume, const DeviceImage<float>& depth, const DeviceImage<ColorT>& color,
+                      const Intrinsics& K, const Eigen::Isometry3f& T_wc, const ReflectionObservation* refl) {
+  if (!K.valid()) throw std::invalid_argument("integrate: invalid intrinsics " + K.to_string());
+  const Device& dev = volume.device();
+  check_image(depth, "depth", K, dev);
+  check_image(color, "colour", K, dev);
+  Buffer<int32_t> remap;
+  if (refl) {
+    if (!refl->plane_ids || !refl->reflection_mask)
+      throw std::invalid_argument("integrate: a reflection observation needs plane ids and a reflection mask");
+    check_image(*refl->plane_ids, "plane id image", K, dev);
+    check_image(*refl->reflection_mask, "reflection mask", K, dev);
+    remap = Buffer<int32_t>::from_host(refl->plane_remap, dev);
+  }
+  const VertexNormalMaps maps = compute_vertex_normal_maps(depth, K);
+  const Eigen::Matrix3f R_wc = T_wc.linear();
+  const Eigen::Vector3f t_wc = T_wc.translation();
+  const Span<const int32_t> active = volume.allocate_from_depth(depth, K, R_wc, t_wc);
+  const TsdfParams& p = volume.params();
+  const Eigen::Matrix3f R_cw = R_wc.transpose();
+  kernel::IntegrateArgs<ColorT> a{depth.view(), color.view(), maps.normals.view(), K, R_cw, Eigen::Vector3f(-(R_cw * t_wc)),
+                                  p.voxel_size, p.truncation, p.min_depth, p.max_depth, p.max_weight,
+                                  p.reflection_window, active, volume.block_keys(), volume.voxels(),
+                                  volume.block_versions(), volume.version(), refl != nullptr,
+                                  refl ? refl->plane_ids->view() : ImageView<const int32_t>{},
+                                  refl ? refl->reflection_mask->view() : ImageView<const uint8_t>{},
+                                  remap.span()};
+  RRG_DISPATCH(dev, kernel::integrate_cpu(a), kernel::integrate_cuda(a));
+  return active.size;
+}
+
+}  // namespace
+
+int64_t integrate(TsdfVolume& volume, const DeviceImage<float>& depth, const DeviceImage<Color>& color,
+                  const Intrinsics& K, const Eigen::Isometry3f& T_wc, const ReflectionObservation* reflection) {
+  return integrate_any(volume, depth, color, K, T_wc, reflection);
+}
+
+int64_t integrate(TsdfVolume& volume, const DeviceImage<float>& depth, const DeviceImage<Rgb8>& color,
+                  const Intrinsics& K, const Eigen::Isometry3f& T_wc, const ReflectionObservation* reflection) {
+  return integrate_any(volume, depth, color, K, T_wc, reflection);
+}
+
+DeviceImage<int32_t> plane_ids_to_device(const LabelImage& labels, const Device& device) {
+  Image<int32_t> ids(labels.width(), labels.height());
+  for (size_t i = 0; i < labels.size(); ++i) ids[i] = labels[i];
+  return DeviceImage<int32_t>::from_host(ids, device);
+}
+
+}  // namespace rrg

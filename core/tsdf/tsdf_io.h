@@ -1,0 +1,26 @@
+#pragma once
+// TSDF volume files (docs/tsdf.md "File format"): a versioned little-endian header with magic,
+// format version, voxel layout size, params, volume version and block count, a 64-bit FNV-1a
+// checksum of the payload, then every block (resident and streamed out) sorted by coordinate.
+#include "core/tsdf/tsdf_volume.h"
+
+#include <cstdint>
+#include <filesystem>
+#include <span>
+
+namespace rrg {
+
+inline constexpr char kTsdfMagic[8] = {'R', 'R', 'G', 'T', 'S', 'D', 'F', '\0'};
+inline constexpr uint32_t kTsdfFormatVersion = 1;
+
+// Written atomically (core/io/atomic_file.h): a failure leaves no file behind.
+void save_volume(const TsdfVolume& volume, const std::filesystem::path& path);
+
+// Throws std::runtime_error naming the file for a missing file, wrong magic, unsupported version,
+// truncation or checksum mismatch. The volume is created on `device`.
+TsdfVolume load_volume(const std::filesystem::path& path, const Device& device);
+
+// 64-bit FNV-1a.
+uint64_t fnv1a64(std::span<const uint8_t> bytes, uint64_t seed = 14695981039346656037ull);
+
+}  // namespace rrg

@@ -1,0 +1,31 @@
+#pragma once
+// TSDF raycasting for any pose, intrinsics and resolution (pass 1 of the renderer; the ICP target
+// of tracking; the variance map of plane identification §4.1.3). Runs on the volume's device.
+#include "core/common/buffer.h"
+#include "core/common/camera.h"
+#include "core/tsdf/tsdf_volume.h"
+
+#include <Eigen/Geometry>
+
+#include <span>
+
+namespace rrg {
+
+// Every image is K's size; pixels without a surface hold 0 everywhere.
+struct RaycastResult {
+  DeviceImage<float> depth;                // D_t: depth along the optical axis, metres
+  DeviceImage<Eigen::Vector3f> vertices;   // V*: world frame
+  DeviceImage<Eigen::Vector3f> normals;    // N*: world frame, unit, pointing out of the surface
+  DeviceImage<Eigen::Vector3f> colors;     // C_t: trilinear c̄
+  DeviceImage<int32_t> plane_ids;          // I: π of the nearest voxel through the remap table
+  DeviceImage<float> reflection;           // R_raw: trilinear r over voxels with n > 0
+  DeviceImage<uint8_t> reflection_mask;    // R = R_raw > 0.5
+  DeviceImage<float> color_variance;       // C_var = Σ w_i σ_i² / (Σ w_i + ε) over voxels with n > 0
+};
+
+// Casts a ray through every pixel of a camera (K, T_wc) within [min_depth, max_depth] of the
+// volume's params; plane ids go through plane_remap (id -> canonical id) as in fusion.
+RaycastResult raycast(const TsdfVolume& volume, const Intrinsics& K, const Eigen::Isometry3f& T_wc,
+                      std::span<const int32_t> plane_remap = {});
+
+}  // namespace rrg

@@ -1,0 +1,16 @@
+#include "core/common/parallel_for.h"
+#include "core/tsdf/tsdf_storage_impl.h"
+
+namespace rrg::kernel {
+
+void touch_blocks_cpu(const TouchArgs& a) { touch_blocks(CpuBackend{}, a); }
+void append_blocks_cpu(const AppendArgs& a) { append_blocks(CpuBackend{}, a); }
+void clear_hash_cpu(HashView h) { clear_hash(CpuBackend{}, h); }
+void insert_known_cpu(HashView h, Span<const uint64_t> keys, int32_t first, int32_t* failed) {
+  insert_known(CpuBackend{}, h, keys, first, failed);
+}
+void copy_blocks_cpu(Span<const Voxel> src, Span<Voxel> dst, Span<const int32_t> index, bool scatter) {
+  copy_blocks(CpuBackend{}, src, dst, index, scatter);
+}
+
+}  // namespace rrg::kernel

@@ -1,0 +1,27 @@
+#include "core/common/parallel_for_cuda.cuh"
+#include "core/tsdf/tsdf_storage_impl.h"
+
+namespace rrg::kernel {
+
+void touch_blocks_cuda(const TouchArgs& a) {
+  touch_blocks(CudaBackend{}, a);
+  RRG_CUDA_CHECK(cudaStreamSynchronize(nullptr));
+}
+void append_blocks_cuda(const AppendArgs& a) {
+  append_blocks(CudaBackend{}, a);
+  RRG_CUDA_CHECK(cudaStreamSynchronize(nullptr));
+}
+void clear_hash_cuda(HashView h) {
+  clear_hash(CudaBackend{}, h);
+  RRG_CUDA_CHECK(cudaStreamSynchronize(nullptr));
+}
+void insert_known_cuda(HashView h, Span<const uint64_t> keys, int32_t first, int32_t* failed) {
+  insert_known(CudaBackend{}, h, keys, first, failed);
+  RRG_CUDA_CHECK(cudaStreamSynchronize(nullptr));
+}
+void copy_blocks_cuda(Span<const Voxel> src, Span<Voxel> dst, Span<const int32_t> index, bool scatter) {
+  copy_blocks(CudaBackend{}, src, dst, index, scatter);
+  RRG_CUDA_CHECK(cudaStreamSynchronize(nullptr));
+}
+
+}  // namespace rrg::kernel

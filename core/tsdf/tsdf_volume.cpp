@@ -1,0 +1,323 @@
+#include "core/tsdf/tsdf_volume.h"
+
+#include "core/common/dispatch.h"
+#include "core/tsdf/tsdf_storage_impl.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+
+namespace rrg {
+namespace {
+
+int64_t next_pow2(int64_t n) {
+  int64_t p = 1;
+  while (p < n) p <<= 1;
+  return p;
+}
+
+template <class T>
+std::vector<T> download_prefix(const Buffer<T>& b, int64_t n) {
+  std::vector<T> out(size_t(std::max<int64_t>(n, 0)));
+  if (n > 0) mem::copy(out.data(), Device::cpu(), b.data(), b.device(), size_t(n) * sizeof(T));
+  return out;
+}
+
+template <class T>
+void resize_keep(Buffer<T>& b, int64_t capacity, int64_t keep, const Device& device) {
+  Buffer<T> bigger(size_t(capacity), device);
+  if (keep > 0) mem::copy(bigger.data(), device, b.data(), device, size_t(keep) * sizeof(T));
+  b = std::move(bigger);
+}
+
+// Initial hash slots per initial pool block: 4096 blocks -> 65536 slots (768 KB), enough for the
+// ~20k blocks a 640x480 frame at 5 mm touches without a grow-and-retry pass.
+constexpr int64_t kHashSlotsPerBlock = 16;
+
+Eigen::Vector3f block_center(const Eigen::Vector3i& c, float voxel_size) {
+  return (c.cast<float>() * float(kBlockSide) + Eigen::Vector3f::Constant(3.5f)) * voxel_size;
+}
+
+}  // namespace
+
+TsdfVolume::TsdfVolume(const TsdfParams& params, const Device& device) : params_(params), device_(device) {
+  params_.validate();
+  require_device(device_);
+  const int64_t blocks = params_.initial_blocks;
+  voxels_ = Buffer<Voxel>(size_t(blocks) * kBlockVoxels, device_);
+  block_keys_ = Buffer<uint64_t>(size_t(blocks), device_);
+  block_versions_ = Buffer<uint64_t>(size_t(blocks), device_);
+  block_stamps_ = Buffer<int32_t>::zeros(size_t(blocks), device_);
+  active_ = Buffer<int32_t>(size_t(blocks), device_);
+  counters_ = Buffer<int32_t>::zeros(4, device_);
+  rehash(next_pow2(kHashSlotsPerBlock * blocks));
+}
+
+kernel::HashView TsdfVolume::hash_view() const {
+  // Read-only kernels take the same view; they never write through it.
+  auto& self = const_cast<TsdfVolume&>(*this);
+  return {self.hash_keys_.span(), self.hash_values_.span()};
+}
+
+MemoryUsage TsdfVolume::memory() const {
+  MemoryUsage m;
+  m.device_bytes = hash_keys_.size() * sizeof(uint64_t) + hash_values_.size() * sizeof(int32_t) +
+                   voxels_.size() * sizeof(Voxel) +
+                   block_keys_.size() * (2 * sizeof(uint64_t) + sizeof(int32_t)) +
+                   new_keys_.size() * sizeof(uint64_t) + new_slots_.size() * sizeof(int32_t) +
+                   active_.size() * sizeof(int32_t) + counters_.size() * sizeof(int32_t);
+  for (const auto& [key, block] : host_blocks_) m.host_bytes += sizeof(BlockData) + block.voxels.size() * sizeof(Voxel) + sizeof(key);
+  return m;
+}
+
+std::vector<Eigen::Vector3i> TsdfVolume::block_coords() const {
+  std::vector<Eigen::Vector3i> out;
+  for (uint64_t k : download_prefix(block_keys_, num_blocks_)) out.push_back(block_coord(k));
+  return out;
+}
+
+std::vector<Eigen::Vector3i> TsdfVolume::changed_blocks(uint64_t since) const {
+  const auto keys = download_prefix(block_keys_, num_blocks_);
+  const auto versions = download_prefix(block_versions_, num_blocks_);
+  std::vector<Eigen::Vector3i> out;
+  for (size_t i = 0; i < keys.size(); ++i)
+    if (versions[i] > since) out.push_back(block_coord(keys[i]));
+  return out;
+}
+
+std::optional<BlockData> TsdfVolume::read_block(const Eigen::Vector3i& coord) const {
+  const uint64_t key = block_key(coord.x(), coord.y(), coord.z());
+  if (auto it = host_blocks_.find(key); it != host_blocks_.end()) return it->second;
+  const auto keys = download_prefix(block_keys_, num_blocks_);
+  const auto it = std::find(keys.begin(), keys.end(), key);
+  if (it == keys.end()) return std::nullopt;
+  const size_t i = size_t(it - keys.begin());
+  BlockData b{coord, 0, std::vector<Voxel>(kBlockVoxels)};
+  mem::copy(b.voxels.data(), Device::cpu(), voxels_.data() + i * kBlockVoxels, device_, kBlockVoxels * sizeof(Voxel));
+  mem::copy(&b.version, Device::cpu(), block_versions_.data() + i, device_, sizeof(uint64_t));
+  return b;
+}
+
+std::vector<BlockData> TsdfVolume::read_all_blocks() const {
+  const auto keys = download_prefix(block_keys_, num_blocks_);
+  const auto versions = download_prefix(block_versions_, num_blocks_);
+  const auto voxels = download_prefix(voxels_, num_blocks_ * kBlockVoxels);
+  std::vector<BlockData> out;
+  out.reserve(keys.size() + host_blocks_.size());
+  for (size_t i = 0; i < keys.size(); ++i)
+    out.push_back({block_coord(keys[i]), versions[i],
+                   std::vector<Voxel>(voxels.begin() + i * kBlockVoxels, voxels.begin() + (i + 1) * kBlockVoxels)});
+  for (const auto& [key, block] : host_blocks_) out.push_back(block);
+  std::sort(out.begin(), out.end(), [](const BlockData& a, const BlockData& b) {
+    return block_key(a.coord.x(), a.coord.y(), a.coord.z()) < block_key(b.coord.x(), b.coord.y(), b.coord.z());
+  });
+  return out;
+}
+
+void TsdfVolume::ensure_pool(int64_t blocks) {
+  const int64_t capacity = int64_t(block_keys_.size());
+  if (blocks <= capacity) return;
+  const int64_t bigger = std::max(blocks, capacity + capacity / 2);
+  spdlog::debug("tsdf: block pool {} -> {} blocks", capacity, bigger);
+  resize_keep(voxels_, bigger * kBlockVoxels, num_blocks_ * kBlockVoxels, device_);
+  resize_keep(block_keys_, bigger, num_blocks_, device_);
+  resize_keep(block_versions_, bigger, num_blocks_, device_);
+  resize_keep(block_stamps_, bigger, num_blocks_, device_);
+  resize_keep(active_, bigger, int64_t(active_.size()), device_);
+}
+
+void TsdfVolume::rehash(int64_t capacity) {
+  capacity = next_pow2(std::max<int64_t>(capacity, 2 * num_blocks_ + 1));
+  for (;;) {
+    hash_keys_ = Buffer<uint64_t>(size_t(capacity), device_);
+    hash_values_ = Buffer<int32_t>(size_t(capacity), device_);
+    const kernel::HashView h = hash_view();
+    RRG_DISPATCH(device_, kernel::clear_hash_cpu(h), kernel::clear_hash_cuda(h));
+    counters_.fill_zero();
+    const Span<const uint64_t> keys = block_keys();
+    int32_t* failed = counters_.data();
+    RRG_DISPATCH(device_, kernel::insert_known_cpu(h, keys, 0, failed),
+                 kernel::insert_known_cuda(h, keys, 0, failed));
+    const int32_t n_failed = download_prefix(counters_, 1)[0];
+    if (n_failed == 0) break;
+    spdlog::info("tsdf: rehash into {} slots left {} blocks without a slot; growing", capacity, n_failed);
+    capacity *= 2;
+  }
+  new_keys_ = Buffer<uint64_t>(size_t(capacity), device_);
+  new_slots_ = Buffer<int32_t>(size_t(capacity), device_);
+}
+
+void TsdfVolume::grow_hash_for(int64_t blocks) {
+  if (2 * blocks > hash_capacity()) {
+    const int64_t capacity = next_pow2(4 * blocks);
+    spdlog::debug("tsdf: hash {} -> {} slots for {} blocks", hash_capacity(), capacity, blocks);
+    rehash(capacity);
+  }
+}
+
+Span<const int32_t> TsdfVolume::allocate_from_depth(const DeviceImage<float>& depth, const Intrinsics& K,
+                                                    const Eigen::Matrix3f& R_wc, const Eigen::Vector3f& t_wc) {
+  ++version_;
+  std::vector<int32_t> counts;
+  for (;;) {
+    ++pass_id_;
+    counters_.fill_zero();
+    kernel::TouchArgs a{depth.view(), K, R_wc, t_wc, params_.voxel_size, params_.truncation,
+                        params_.min_depth, params_.max_depth, hash_view(),
+                        {block_stamps_.data(), num_blocks_}, pass_id_, new_keys_.span(), new_slots_.span(),
+                        {active_.data(), num_blocks_}, counters_.data()};
+    RRG_DISPATCH(device_, kernel::touch_blocks_cpu(a), kernel::touch_blocks_cuda(a));
+    counts = download_prefix(counters_, 3);
+    if (counts[2] == 0) break;
+    // Never drop a block: the pass runs again on a table twice as big (pending inserts are dropped
+    // by the rehash, and the new pass id lists every touched block afresh).
+    spdlog::debug("tsdf: hash table of {} slots full for {} block inserts; growing to {}", hash_capacity(),
+                  counts[2], 4 * hash_capacity());
+    rehash(4 * hash_capacity());
+  }
+  const int64_t n_new = counts[0], n_active = counts[1];
+  if (n_new > 0) {
+    std::vector<uint64_t> keys = download_prefix(new_keys_, n_new);
+    const std::vector<int32_t> slots32 = download_prefix(new_slots_, n_new);
+    std::vector<size_t> order(static_cast<size_t>(n_new));
+    std::iota(order.begin(), order.end(), size_t{0});
+    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return keys[a] < keys[b]; });
+    std::vector<uint64_t> sorted_keys(order.size());
+    std::vector<int64_t> sorted_slots(order.size());
+    std::vector<const BlockData*> restored(order.size(), nullptr);
+    for (size_t j = 0; j < order.size(); ++j) {
+      sorted_keys[j] = keys[order[j]];
+      sorted_slots[j] = slots32[order[j]];
+      if (auto it = host_blocks_.find(sorted_keys[j]); it != host_blocks_.end()) restored[j] = &it->second;
+    }
+    append_blocks(sorted_keys, sorted_slots, restored, n_active);
+  }
+  grow_hash_for(num_blocks_);
+  return {active_.data(), n_active + n_new};
+}
+
+void TsdfVolume::append_blocks(std::span<const uint64_t> keys, std::span<const int64_t> slots,
+                               std::span<const BlockData* const> restored, int64_t active_offset) {
+  const int64_t n = int64_t(keys.size()), first = num_blocks_;
+  ensure_pool(first + n);
+  const auto keys_d = Buffer<uint64_t>::from_host(keys, device_);
+  std::vector<int32_t> slots32(slots.begin(), slots.end());
+  const auto slots_d = Buffer<int32_t>::from_host(slots32, device_);
+  const int64_t capacity = int64_t(block_keys_.size());
+  kernel::AppendArgs a{hash_view(), keys_d.span(), slots_d.span(), int32_t(first),
+                       block_keys_.span(), block_versions_.span(), block_stamps_.span(), pass_id_, version_,
+                       {active_.data(), capacity}, int32_t(active_offset), voxels_.span()};
+  RRG_DISPATCH(device_, kernel::append_blocks_cpu(a), kernel::append_blocks_cuda(a));
+  num_blocks_ += n;
+  // Blocks coming back from host memory: their voxels replace the zeros.
+  std::vector<int32_t> index;
+  std::vector<Voxel> staged;
+  for (int64_t j = 0; j < n; ++j) {
+    if (!restored[size_t(j)]) continue;
+    index.push_back(int32_t(first + j));
+    staged.insert(staged.end(), restored[size_t(j)]->voxels.begin(), restored[size_t(j)]->voxels.end());
+  }
+  if (!index.empty()) {
+    const auto index_d = Buffer<int32_t>::from_host(index, device_);
+    const auto staged_d = Buffer<Voxel>::from_host(staged, device_);
+    const Span<const Voxel> src = staged_d.span();
+    const Span<const int32_t> idx = index_d.span();
+    RRG_DISPATCH(device_, kernel::copy_blocks_cpu(src, voxels_.span(), idx, true),
+                 kernel::copy_blocks_cuda(src, voxels_.span(), idx, true));
+    for (int64_t j = 0; j < n; ++j)
+      if (restored[size_t(j)]) host_blocks_.erase(keys[size_t(j)]);
+    spdlog::debug("tsdf: {} blocks streamed back in", index.size());
+  }
+}
+
+void TsdfVolume::insert_blocks(std::span<const BlockData> blocks) {
+  if (blocks.empty()) return;
+  const auto existing = download_prefix(block_keys_, num_blocks_);
+  std::vector<uint64_t> present(existing);
+  std::sort(present.begin(), present.end());
+  const int64_t n = int64_t(blocks.size()), first = num_blocks_;
+  std::vector<uint64_t> keys, versions;
+  std::vector<Voxel> staged;
+  staged.reserve(size_t(n) * kBlockVoxels);
+  for (const BlockData& b : blocks) {
+    if (!block_in_range(b.coord.x(), b.coord.y(), b.coord.z()) || b.voxels.size() != size_t(kBlockVoxels))
+      throw std::invalid_argument("TsdfVolume::insert_blocks: block out of range or not 512 voxels");
+    const uint64_t key = block_key(b.coord.x(), b.coord.y(), b.coord.z());
+    if (std::binary_search(present.begin(), present.end(), key))
+      throw std::invalid_argument("TsdfVolume::insert_blocks: block already present");
+    keys.push_back(key);
+    versions.push_back(b.version);
+    staged.insert(staged.end(), b.voxels.begin(), b.voxels.end());
+  }
+  ensure_pool(first + n);
+  mem::copy(block_keys_.data() + first, device_, keys.data(), Device::cpu(), keys.size() * sizeof(uint64_t));
+  mem::copy(block_versions_.data() + first, device_, versions.data(), Device::cpu(), versions.size() * sizeof(uint64_t));
+  mem::copy(voxels_.data() + first * kBlockVoxels, device_, staged.data(), Device::cpu(), staged.size() * sizeof(Voxel));
+  mem::fill_zero(block_stamps_.data() + first, size_t(n) * sizeof(int32_t), device_);
+  num_blocks_ += n;
+  rehash(std::max(hash_capacity(), next_pow2(4 * num_blocks_)));
+}
+
+int64_t TsdfVolume::stream_out(const Eigen::Vector3f& center, float radius) {
+  const auto keys = download_prefix(block_keys_, num_blocks_);
+  const auto versions = download_prefix(block_versions_, num_blocks_);
+  std::vector<int32_t> out, keep;
+  for (int64_t i = 0; i < num_blocks_; ++i)
+    ((block_center(block_coord(keys[size_t(i)]), params_.voxel_size) - center).norm() > radius ? out : keep)
+        .push_back(int32_t(i));
+  if (out.empty()) return 0;
+  const auto gather = [&](const std::vector<int32_t>& which, Buffer<Voxel>& dst) {
+    const auto index_d = Buffer<int32_t>::from_host(which, device_);
+    const Span<const Voxel> src = voxels();
+    const Span<const int32_t> idx = index_d.span();
+    RRG_DISPATCH(device_, kernel::copy_blocks_cpu(src, dst.span(), idx, false),
+                 kernel::copy_blocks_cuda(src, dst.span(), idx, false));
+  };
+  Buffer<Voxel> moved(out.size() * kBlockVoxels, device_);
+  gather(out, moved);
+  const std::vector<Voxel> host = moved.to_host();
+  for (size_t j = 0; j < out.size(); ++j) {
+    const uint64_t key = keys[size_t(out[j])];
+    host_blocks_[key] = BlockData{block_coord(key), versions[size_t(out[j])],
+                                  std::vector<Voxel>(host.begin() + j * kBlockVoxels, host.begin() + (j + 1) * kBlockVoxels)};
+  }
+  // Compact the pool to the kept blocks and rebuild the hash.
+  Buffer<Voxel> kept(voxels_.size(), device_);
+  gather(keep, kept);
+  voxels_ = std::move(kept);
+  std::vector<uint64_t> kept_keys, kept_versions;
+  for (int32_t i : keep) {
+    kept_keys.push_back(keys[size_t(i)]);
+    kept_versions.push_back(versions[size_t(i)]);
+  }
+  num_blocks_ = int64_t(keep.size());
+  if (num_blocks_ > 0) {
+    mem::copy(block_keys_.data(), device_, kept_keys.data(), Device::cpu(), kept_keys.size() * sizeof(uint64_t));
+    mem::copy(block_versions_.data(), device_, kept_versions.data(), Device::cpu(), kept_versions.size() * sizeof(uint64_t));
+  }
+  block_stamps_.fill_zero();
+  rehash(hash_capacity());
+  spdlog::debug("tsdf: {} blocks streamed out ({} resident)", out.size(), num_blocks_);
+  return int64_t(out.size());
+}
+
+int64_t TsdfVolume::stream_in(const Eigen::Vector3f& center, float radius) {
+  std::vector<BlockData> back;
+  for (const auto& [key, block] : host_blocks_)
+    if ((block_center(block.coord, params_.voxel_size) - center).norm() <= radius) back.push_back(block);
+  std::sort(back.begin(), back.end(), [](const BlockData& a, const BlockData& b) {
+    return block_key(a.coord.x(), a.coord.y(), a.coord.z()) < block_key(b.coord.x(), b.coord.y(), b.coord.z());
+  });
+  insert_blocks(back);
+  for (const BlockData& b : back) host_blocks_.erase(block_key(b.coord.x(), b.coord.y(), b.coord.z()));
+  return int64_t(back.size());
+}
+
+int64_t TsdfVolume::stream_in_all() {
+  return stream_in(Eigen::Vector3f::Zero(), std::numeric_limits<float>::infinity());
+}
+
+}  // namespace rrg

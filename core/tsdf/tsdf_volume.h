@@ -1,0 +1,115 @@
+#pragma once
+// The augmented TSDF volume S (paper §3.1, §4.1.4): a sparse voxel-hashed grid of 8³-voxel blocks
+// on one device (CPU or CUDA), no dense grid. Blocks are allocated from each frame's depth inside
+// the truncation band; the hash and the block pool grow on the host between frames (rehash), and
+// an insert that finds no slot makes the pass run again on a bigger table, so no block is dropped.
+// Blocks far from the camera can be streamed out to host memory and come back when touched again.
+//
+// The algorithms on the volume live in their own headers:
+//   tsdf_integrate.h  fusion of a posed RGB-D frame (+ reflection attributes on identification frames)
+//   tsdf_raycast.h    D_t, vertices, normals, C_t, plane ids I, R_raw / R, C_var for any camera
+//   tsdf_mesh.h       marching cubes (whole volume, or a set of blocks) with colours and plane ids
+//   tsdf_io.h         versioned, checksummed save / load
+#include "core/common/buffer.h"
+#include "core/common/camera.h"
+#include "core/tsdf/tsdf_params.h"
+#include "core/tsdf/voxel.h"
+#include "core/tsdf/voxel_hash_device.h"
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <unordered_map>
+#include <vector>
+
+namespace rrg {
+
+struct MemoryUsage {
+  size_t device_bytes = 0;  // hash, block pool and per-block data on the volume's device
+  size_t host_bytes = 0;    // streamed-out blocks held in host memory
+};
+
+// A block's voxels as stored (for inspection, tests, streaming and files).
+struct BlockData {
+  Eigen::Vector3i coord;          // block coordinate (voxel g lies in block floor(g / 8))
+  uint64_t version = 0;           // volume version of the last frame that fused into it
+  std::vector<Voxel> voxels;      // 512, x fastest
+};
+
+class TsdfVolume {
+ public:
+  // Throws std::invalid_argument for bad params, std::runtime_error when the device is unusable.
+  TsdfVolume(const TsdfParams& params, const Device& device);
+  TsdfVolume(TsdfVolume&&) noexcept = default;
+  TsdfVolume& operator=(TsdfVolume&&) noexcept = default;
+
+  const TsdfParams& params() const { return params_; }
+  const Device& device() const { return device_; }
+  int64_t num_blocks() const { return num_blocks_; }                     // resident on the device
+  int64_t num_host_blocks() const { return int64_t(host_blocks_.size()); }  // streamed out
+  int64_t hash_capacity() const { return int64_t(hash_keys_.size()); }
+  uint64_t version() const { return version_; }  // number of integrated frames (and loads)
+  MemoryUsage memory() const;
+
+  // Resident block coordinates in pool order.
+  std::vector<Eigen::Vector3i> block_coords() const;
+  // Resident blocks fused into after version `since` (0 = every block ever fused), for streaming
+  // changed mesh blocks.
+  std::vector<Eigen::Vector3i> changed_blocks(uint64_t since) const;
+  // One block, resident or streamed out; nullopt when never allocated.
+  std::optional<BlockData> read_block(const Eigen::Vector3i& coord) const;
+  // Every block (resident and streamed out), sorted by coordinate (x, then y, then z).
+  std::vector<BlockData> read_all_blocks() const;
+
+  // Streaming: moves resident blocks whose centre is farther than radius from centre to host
+  // memory, or brings streamed-out blocks within radius back. Returns the number of blocks moved.
+  // Integration brings back any streamed-out block that a frame touches.
+  int64_t stream_out(const Eigen::Vector3f& center, float radius);
+  int64_t stream_in(const Eigen::Vector3f& center, float radius);
+  int64_t stream_in_all();
+
+  // --- used by the algorithms (tsdf_integrate.cpp, tsdf_raycast.cpp, ...) -----------------------
+  kernel::HashView hash_view() { return {hash_keys_.span(), hash_values_.span()}; }
+  kernel::HashView hash_view() const;
+  Span<Voxel> voxels() { return {voxels_.data(), num_blocks_ * kBlockVoxels}; }
+  Span<const Voxel> voxels() const { return {voxels_.data(), num_blocks_ * kBlockVoxels}; }
+  Span<const uint64_t> block_keys() const { return {block_keys_.data(), num_blocks_}; }
+  Span<uint64_t> block_versions() { return {block_versions_.data(), num_blocks_}; }
+  // Allocates (and brings back from the host) every block on the rays of the valid depth pixels
+  // within [d - ε, d + ε]; returns the indices of the blocks touched by this frame (the active set),
+  // valid until the next call. Increments version().
+  Span<const int32_t> allocate_from_depth(const DeviceImage<float>& depth, const Intrinsics& K,
+                                          const Eigen::Matrix3f& R_wc, const Eigen::Vector3f& t_wc);
+  // Adds blocks that are not in the volume (files, streaming). Throws if one is already present.
+  void insert_blocks(std::span<const BlockData> blocks);
+  void set_version(uint64_t v) { version_ = v; }
+
+ private:
+  void ensure_pool(int64_t blocks);       // pool capacity >= blocks (copying)
+  void rehash(int64_t capacity);          // new table of `capacity` slots with every resident block
+  void grow_hash_for(int64_t blocks);     // keeps the load factor <= 1/2
+  void append_blocks(std::span<const uint64_t> keys, std::span<const int64_t> slots,
+                     std::span<const BlockData* const> restored, int64_t active_offset);
+
+  TsdfParams params_;
+  Device device_;
+  Buffer<uint64_t> hash_keys_;       // [capacity] packed block coordinates, kEmptyKey = free
+  Buffer<int32_t> hash_values_;      // [capacity] block index, -1 = free
+  Buffer<Voxel> voxels_;             // [pool capacity * 512]
+  Buffer<uint64_t> block_keys_;      // [pool capacity]
+  Buffer<uint64_t> block_versions_;  // [pool capacity] version of the last fusion into the block
+  Buffer<int32_t> block_stamps_;     // [pool capacity] allocation pass that last listed it active
+  int64_t num_blocks_ = 0;
+  uint64_t version_ = 0;
+  int32_t pass_id_ = 0;
+  // Scratch of allocate_from_depth, kept between frames.
+  Buffer<uint64_t> new_keys_;
+  Buffer<int32_t> new_slots_;
+  Buffer<int32_t> active_;
+  Buffer<int32_t> counters_;
+  std::unordered_map<uint64_t, BlockData> host_blocks_;  // streamed out, by key
+};
+
+}  // namespace rrg

@@ -1,0 +1,61 @@
+// `rrg fuse` end to end: a synthetic office sequence (rrg synth) fused with its ground-truth poses,
+// the mesh scored against the ground-truth mesh with `rrg eval mesh`, and the error paths.
+#include "core/tsdf/tsdf_io.h"
+#include "tests/support/test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <regex>
+
+namespace rrg {
+namespace {
+
+TEST(TsdfCli, FusesASyntheticSequenceIntoAnAccurateMesh) {
+  const test::TempDir tmp("tsdf-cli");
+  const std::string dir = (tmp / "office").string();
+  const auto synth = test::run_rrg("synth --preset office --frames 20 --width 160 --height 120 --out " + dir);
+  ASSERT_EQ(synth.exit_code, 0) << synth.output;
+  const std::string mesh = (tmp / "mesh.ply").string(), vol = (tmp / "v.tsdf").string();
+  const auto fuse = test::run_rrg("fuse " + dir + " --out " + mesh + " --voxel 0.02 --device cpu --save " + vol);
+  ASSERT_EQ(fuse.exit_code, 0) << fuse.output;
+  EXPECT_NE(fuse.output.find("fused 20 frames"), std::string::npos) << fuse.output;
+  EXPECT_NE(fuse.output.find("fusion"), std::string::npos) << fuse.output;  // timing summary
+  EXPECT_EQ(load_volume(vol, Device::cpu()).version(), 20u);
+
+  // Accuracy is measured to samples of the whole-room ground-truth mesh (~120 m^2), so the sample
+  // spacing sqrt(A/N) sets a floor: 1M samples give ~1 cm spacing, a mean floor of ~0.5 cm, far
+  // below the 2 cm (one voxel) bound. (50k samples would put the floor itself at ~2.5 cm.)
+  const auto eval = test::run_rrg("eval mesh --est " + mesh + " --ref " + dir + "/mesh_gt.ply --samples 1000000");
+  ASSERT_EQ(eval.exit_code, 0) << eval.output;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(eval.output, m, std::regex(R"(accuracy \(cm\)\s+([0-9.]+))"))) << eval.output;
+  EXPECT_LT(std::stod(m[1]), 2.0) << eval.output;
+}
+
+TEST(TsdfCli, ErrorsExitWithAMessage) {
+  const test::TempDir tmp("tsdf-cli");
+  const auto missing = test::run_rrg("fuse " + (tmp / "nope").string() + " --out " + (tmp / "m.ply").string());
+  EXPECT_EQ(missing.exit_code, 1) << missing.output;
+  EXPECT_NE(missing.output.find("rrg: error:"), std::string::npos) << missing.output;
+  EXPECT_FALSE(std::filesystem::exists(tmp / "m.ply"));
+  const auto usage = test::run_rrg("fuse " + (tmp / "nope").string());  // no --out
+  EXPECT_NE(usage.exit_code, 0) << usage.output;  // CLI11's usage error
+  EXPECT_NE(usage.output.find("--out is required"), std::string::npos) << usage.output;
+  const auto bad_every = test::run_rrg("fuse " + (test::test_data_dir() / "7scenes_mini").string() +
+                                       " --out " + (tmp / "m.ply").string() + " --every 0");
+  EXPECT_EQ(bad_every.exit_code, 1) << bad_every.output;
+  EXPECT_NE(bad_every.output.find("--every"), std::string::npos) << bad_every.output;
+}
+
+TEST(TsdfCli, FusesRealFramesOf7Scenes) {
+  const test::TempDir tmp("tsdf-cli");
+  const std::string mesh = (tmp / "m.ply").string();
+  const auto r = test::run_rrg("fuse " + (test::test_data_dir() / "7scenes_mini").string() + " --out " + mesh +
+                               " --voxel 0.02 --device cpu --stream-radius 1.5");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("fused 3 frames"), std::string::npos) << r.output;
+  EXPECT_GT(std::filesystem::file_size(mesh), 10000u);
+}
+
+}  // namespace
+}  // namespace rrg

@@ -1,0 +1,129 @@
+// Marching cubes on the TSDF: area and closure of a sphere, orientation, welding, device parity,
+// and the generated case table.
+#include "core/tsdf/marching_cubes_table.h"
+#include "core/tsdf/tsdf_mesh.h"
+#include "tests/support/parity.h"
+#include "tests/tsdf/analytic_scene.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <numbers>
+
+namespace rrg {
+namespace {
+
+const Intrinsics kK{150.0f, 150.0f, 79.5f, 59.5f, 160, 120};
+const Eigen::Vector3f kC(0.02f, -0.03f, 0.01f);
+constexpr float kR = 0.25f;
+
+TsdfVolume fused_sphere(const Device& device) {
+  TsdfParams p;
+  p.voxel_size = 0.01f;
+  p.truncation = 0.04f;
+  TsdfVolume v(p, device);
+  test::fuse_scene(v, test::sphere_scene(kC, kR), kK, test::cameras_around(kC, 0.9f), Color(0.2f, 0.6f, 0.4f));
+  return v;
+}
+
+double area(const TriangleMesh& m) {
+  double a = 0;
+  for (const auto& t : m.triangles)
+    a += 0.5 * double((m.vertices[size_t(t.y())] - m.vertices[size_t(t.x())])
+                          .cross(m.vertices[size_t(t.z())] - m.vertices[size_t(t.x())]).norm());
+  return a;
+}
+
+TEST(TsdfMesh, SphereHasTheRightAreaIsClosedAndFacesOutwards) {
+  const TsdfVolume v = fused_sphere(Device::cpu());
+  const TriangleMesh m = extract_mesh(v);
+  m.validate();
+  ASSERT_GT(m.triangles.size(), 1000u);
+  const double expected = 4.0 * std::numbers::pi * kR * kR;
+  EXPECT_NEAR(area(m) / expected, 1.0, 0.02) << "area " << area(m) << " vs 4πr² " << expected;
+  // Closed and welded: every undirected edge is shared by exactly two triangles, once each way.
+  std::map<std::pair<int, int>, int> directed;
+  for (const auto& t : m.triangles)
+    for (int k = 0; k < 3; ++k) ++directed[{t[k], t[(k + 1) % 3]}];
+  for (const auto& [e, count] : directed) {
+    ASSERT_EQ(count, 1) << "edge " << e.first << "-" << e.second << " used twice in one direction";
+    ASSERT_EQ(directed.count({e.second, e.first}), 1u) << "open edge " << e.first << "-" << e.second;
+  }
+  size_t outward = 0;
+  for (const auto& t : m.triangles) {
+    const Eigen::Vector3f a = m.vertices[size_t(t.x())], b = m.vertices[size_t(t.y())], c = m.vertices[size_t(t.z())];
+    outward += (b - a).cross(c - a).dot((a + b + c) / 3.0f - kC) > 0.0f;
+  }
+  EXPECT_EQ(outward, m.triangles.size());
+  for (size_t i = 0; i < m.vertices.size(); ++i) {
+    ASSERT_NEAR((m.vertices[i] - kC).norm(), kR, 0.003f);
+    ASSERT_LT((m.colors[i] - Eigen::Vector3f(0.2f, 0.6f, 0.4f)).norm(), 1e-3f);
+    ASSERT_EQ(m.plane_ids[i], 0);
+  }
+}
+
+TEST(TsdfMesh, BlocksMeshedSeparatelyWeldToTheWholeMesh) {
+  const TsdfVolume v = fused_sphere(Device::cpu());
+  const TriangleMesh whole = extract_mesh(v);
+  const auto coords = v.block_coords();
+  size_t triangles = 0, vertices = 0;
+  double parts = 0;
+  for (size_t i = 0; i < coords.size(); i += 64) {  // meshed in groups of blocks
+    const std::vector<Eigen::Vector3i> group(coords.begin() + long(i), coords.begin() + long(std::min(coords.size(), i + 64)));
+    const TriangleMesh m = extract_mesh(v, group);
+    triangles += m.triangles.size();
+    vertices += m.vertices.size();
+    parts += area(m);
+  }
+  EXPECT_EQ(triangles, whole.triangles.size());
+  EXPECT_GT(vertices, whole.vertices.size());  // group borders are not welded across groups
+  EXPECT_NEAR(parts, area(whole), 1e-6 * area(whole));
+}
+
+TEST(TsdfMesh, SameMeshOnEveryDevice) {
+  test::expect_device_parity<float>(
+      [](const Device& device) {
+        const TriangleMesh m = extract_mesh(fused_sphere(device));
+        std::vector<float> out;
+        for (const auto& p : m.vertices) out.insert(out.end(), {p.x(), p.y(), p.z()});
+        for (const auto& t : m.triangles) out.insert(out.end(), {float(t.x()), float(t.y()), float(t.z())});
+        return out;
+      },
+      2e-4, 0.0);
+}
+
+TEST(TsdfMesh, CaseTableIsClosedAndComplete) {
+  const auto& table = mc::triangle_table();
+  const auto triangles = [&](int m) {
+    int n = 0;
+    while (table[size_t(m * mc::kStride + 3 * n)] >= 0) ++n;
+    return n;
+  };
+  EXPECT_EQ(triangles(0), 0);
+  EXPECT_EQ(triangles(255), 0);
+  for (int c = 0; c < 8; ++c) {
+    EXPECT_EQ(triangles(1 << c), 1) << "one corner inside";
+    EXPECT_EQ(triangles(255 ^ (1 << c)), 1) << "one corner outside";
+  }
+  EXPECT_EQ(triangles(0b00001111), 2);  // a face's four corners: one quad
+  for (int m = 1; m < 255; ++m) {
+    // every triangle edge crosses the surface: its two corners differ
+    for (int k = 0; table[size_t(m * mc::kStride + k)] >= 0; ++k) {
+      const int e = table[size_t(m * mc::kStride + k)];
+      const Eigen::Vector3i a = mc::edge_origin(e);
+      Eigen::Vector3i b = a;
+      b[mc::edge_axis(e)] = 1;
+      const int ca = a.x() + 2 * a.y() + 4 * a.z(), cb = b.x() + 2 * b.y() + 4 * b.z();
+      ASSERT_NE((m >> ca) & 1, (m >> cb) & 1) << "case " << m << " edge " << e;
+    }
+  }
+}
+
+TEST(TsdfMesh, EmptyVolumeGivesAnEmptyMesh) {
+  TsdfVolume v(TsdfParams{}, Device::cpu());
+  EXPECT_TRUE(extract_mesh(v).triangles.empty());
+}
+
+}  // namespace
+}  // namespace rrg

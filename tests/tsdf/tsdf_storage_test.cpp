@@ -1,0 +1,155 @@
+// The volume's storage: race-free block allocation with growth, streaming to host memory and
+// back, changed-block tracking, memory accounting.
+#include "core/tsdf/tsdf_integrate.h"
+#include "core/tsdf/tsdf_mesh.h"
+#include "core/tsdf/tsdf_raycast.h"
+#include "core/tsdf/tsdf_storage_impl.h"
+#include "tests/support/parity.h"
+#include "tests/tsdf/analytic_scene.h"
+
+#include <gtest/gtest.h>
+
+#include <set>
+#include <tuple>
+
+namespace rrg {
+namespace {
+
+const Intrinsics kK{150.0f, 150.0f, 79.5f, 59.5f, 160, 120};
+using BlockSet = std::set<std::tuple<int, int, int>>;
+
+TsdfParams params(int64_t initial_blocks = 4096) {
+  TsdfParams p;
+  p.voxel_size = 0.01f;
+  p.truncation = 0.04f;
+  p.initial_blocks = initial_blocks;
+  return p;
+}
+
+// The blocks on every pixel's ray within [d − ε, d + ε], one pixel at a time into a std::set.
+BlockSet expected_blocks(const DepthImage& depth, const Eigen::Isometry3f& T, const TsdfParams& p) {
+  BlockSet out;
+  const float to_block = 1.0f / (p.voxel_size * kBlockSide), half = 0.5f / kBlockSide;
+  for (int y = 0; y < depth.height(); ++y)
+    for (int x = 0; x < depth.width(); ++x) {
+      const float d = depth(x, y);
+      if (!(d >= p.min_depth && d <= p.max_depth)) continue;
+      const Eigen::Vector3f a = T * kK.unproject(float(x), float(y), d - p.truncation);
+      const Eigen::Vector3f b = T * kK.unproject(float(x), float(y), d + p.truncation);
+      kernel::for_blocks_on_segment(a * to_block + Eigen::Vector3f::Constant(half),
+                                    b * to_block + Eigen::Vector3f::Constant(half),
+                                    [&](const Eigen::Vector3i& c) { out.insert({c.x(), c.y(), c.z()}); });
+      // Independent check of the traversal: dense samples along the segment land in visited blocks.
+      if ((x + y) % 7 == 0)
+        for (int k = 0; k <= 200; ++k) {
+          const Eigen::Vector3f q = (a + (b - a) * (float(k) / 200.0f)) * to_block + Eigen::Vector3f::Constant(half);
+          EXPECT_TRUE(out.count({int(std::floor(q.x())), int(std::floor(q.y())), int(std::floor(q.z()))}));
+        }
+    }
+  return out;
+}
+
+BlockSet allocated(const TsdfVolume& v) {
+  BlockSet out;
+  for (const auto& c : v.block_coords()) out.insert({c.x(), c.y(), c.z()});
+  return out;
+}
+
+TEST(TsdfStorage, AllocationFindsExactlyTheBlocksOnTheRaysWithoutLosingAny) {
+  // Every pixel of a fronto-parallel wall hits the same few blocks: maximal contention on the hash.
+  // A table of 2 slots to start with forces several grow-and-retry passes within the first frame.
+  const DepthImage wall(kK.width, kK.height, 1.0f);
+  const test::Scene sphere = test::sphere_scene({0, 0, 0}, 0.3f);
+  const auto T0 = Eigen::Isometry3f::Identity();
+  const auto T1 = test::look_at({0.2f, -0.1f, -0.9f}, {0, 0, 0});
+  const DepthImage ball = sphere.render_depth(kK, T1);
+  BlockSet want = expected_blocks(wall, T0, params(1));
+  const BlockSet after_first = want;
+  for (const auto& b : expected_blocks(ball, T1, params(1))) want.insert(b);
+  for (const Device& device : available_devices()) {
+    SCOPED_TRACE(device.to_string());
+    TsdfVolume v(params(1), device);
+    const ColorImage grey(kK.width, kK.height, Color(0.5f, 0.5f, 0.5f));
+    const auto c = DeviceImage<Color>::from_host(grey, device);
+    EXPECT_EQ(integrate(v, DeviceImage<float>::from_host(wall, device), c, kK, T0), int64_t(after_first.size()));
+    EXPECT_EQ(allocated(v), after_first);
+    EXPECT_EQ(v.num_blocks(), int64_t(after_first.size()));  // no duplicates
+    integrate(v, DeviceImage<float>::from_host(ball, device), c, kK, T1);
+    EXPECT_EQ(allocated(v), want);
+    EXPECT_EQ(v.num_blocks(), int64_t(want.size()));
+    EXPECT_GE(v.hash_capacity(), 2 * v.num_blocks());  // load factor kept <= 1/2
+  }
+}
+
+TEST(TsdfStorage, StreamingOutAndBackInIsExact) {
+  const Eigen::Vector3f c(0, 0, 0);
+  const test::Scene scene = test::sphere_scene(c, 0.25f);
+  const auto novel = test::look_at({0.5f, 0.4f, -0.6f}, c);
+  for (const Device& device : available_devices()) {
+    SCOPED_TRACE(device.to_string());
+    TsdfVolume v(params(), device);
+    test::fuse_scene(v, scene, kK, test::cameras_around(c, 0.9f));
+    const auto before = test::flatten_voxels(v);
+    const auto depth_before = raycast(v, kK, novel).depth.to_host();
+    const int64_t total = v.num_blocks();
+    const MemoryUsage m0 = v.memory();
+    EXPECT_EQ(m0.host_bytes, 0u);
+
+    const int64_t moved = v.stream_out({0.3f, 0, 0}, 0.3f);  // keeps the +x half resident
+    EXPECT_GT(moved, 0);
+    EXPECT_LT(moved, total);
+    EXPECT_EQ(v.num_blocks() + v.num_host_blocks(), total);
+    EXPECT_GE(v.memory().host_bytes, size_t(moved) * kBlockVoxels * sizeof(Voxel));
+    EXPECT_EQ(test::flatten_voxels(v), before);  // read_all_blocks sees both places
+    for (const auto& b : v.block_coords())
+      EXPECT_LE((((b.cast<float>() * 8.0f).array() + 3.5f).matrix() * 0.01f - Eigen::Vector3f(0.3f, 0, 0)).norm(), 0.3f);
+
+    EXPECT_EQ(v.stream_in({-0.3f, 0, 0}, 0.2f) + v.stream_in_all(), moved);
+    EXPECT_EQ(v.num_host_blocks(), 0);
+    EXPECT_EQ(v.num_blocks(), total);
+    EXPECT_EQ(test::flatten_voxels(v), before);
+    const auto depth_after = raycast(v, kK, novel).depth.to_host();
+    EXPECT_TRUE(std::equal(depth_after.pixels().begin(), depth_after.pixels().end(), depth_before.pixels().begin()));
+  }
+}
+
+TEST(TsdfStorage, IntegrationBringsStreamedOutBlocksBack) {
+  const test::Scene scene = test::sphere_scene({0, 0, 0}, 0.25f);
+  const auto poses = test::cameras_around({0, 0, 0}, 0.9f);
+  for (const Device& device : available_devices()) {
+    SCOPED_TRACE(device.to_string());
+    TsdfVolume streamed(params(), device), plain(params(), device);
+    test::fuse_scene(streamed, scene, kK, poses);
+    test::fuse_scene(plain, scene, kK, poses);
+    EXPECT_EQ(streamed.stream_out({10, 10, 10}, 0.1f), plain.num_blocks());
+    EXPECT_EQ(streamed.num_blocks(), 0);
+    test::fuse_scene(streamed, scene, kK, {poses[0]});
+    test::fuse_scene(plain, scene, kK, {poses[0]});
+    EXPECT_GT(streamed.num_blocks(), 0);
+    EXPECT_GT(streamed.num_host_blocks(), 0);  // blocks the last frame did not touch stay out
+    EXPECT_EQ(test::flatten_voxels(streamed), test::flatten_voxels(plain));
+  }
+}
+
+TEST(TsdfStorage, ChangedBlocksAreThoseFusedSinceAVersion) {
+  TsdfVolume v(params(), Device::cpu());
+  const test::Scene scene = test::sphere_scene({0, 0, 0}, 0.25f);
+  const auto poses = test::cameras_around({0, 0, 0}, 0.9f);
+  test::fuse_scene(v, scene, kK, {poses[0]});  // camera at −x
+  const uint64_t v1 = v.version();
+  EXPECT_EQ(v1, 1u);
+  const auto first = allocated(v);
+  test::fuse_scene(v, scene, kK, {poses[1]});  // camera at +x
+  const auto changed = v.changed_blocks(v1);
+  EXPECT_FALSE(changed.empty());
+  EXPECT_LT(changed.size(), size_t(v.num_blocks()));
+  EXPECT_EQ(v.changed_blocks(0).size(), size_t(v.num_blocks()));
+  EXPECT_TRUE(v.changed_blocks(v.version()).empty());
+  const TriangleMesh part = extract_mesh(v, changed), whole = extract_mesh(v);
+  EXPECT_GT(part.triangles.size(), 0u);
+  EXPECT_LT(part.triangles.size(), whole.triangles.size());
+  for (const auto& p : part.vertices) ASSERT_GT(p.x(), -0.05f);  // the side the second camera saw
+}
+
+}  // namespace
+}  // namespace rrg
