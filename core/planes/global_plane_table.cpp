@@ -1,0 +1,230 @@
+#include "core/planes/global_plane_table.h"
+
+#include <spdlog/fmt/fmt.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+namespace rrg {
+
+void GlobalPlaneParams::validate() const {
+  auto need = [](bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(std::string("GlobalPlaneParams: ") + what);
+  };
+  need(max_normal_angle_deg > 0 && max_normal_angle_deg < 90, "max_normal_angle_deg must be in (0, 90)");
+  need(max_distance > 0, "max_distance must be > 0");
+  need(cell_size > 0, "cell_size must be > 0");
+  need(min_overlap >= 0 && min_overlap < 1, "min_overlap must be in [0, 1)");
+  need(min_iou >= 0 && min_iou < 1, "min_iou must be in [0, 1)");
+  need(max_gap >= 0, "max_gap must be >= 0");
+  need(recent_frames >= 0, "recent_frames must be >= 0");
+  need(merge_min_overlap > 0 && merge_min_overlap <= 1, "merge_min_overlap must be in (0, 1]");
+  need(point_stride >= 1, "point_stride must be >= 1");
+}
+
+std::string GlobalPlaneParams::to_string() const {
+  return fmt::format("normal <= {} deg, distance <= {} m, grid {} m, overlap > {}, IoU > {}, gap < {} m "
+                     "(seen within {} frames), merge overlap > {}",
+                     max_normal_angle_deg, max_distance, cell_size, min_overlap, min_iou, max_gap,
+                     recent_frames, merge_min_overlap);
+}
+
+GlobalPlaneTable::GlobalPlaneTable(const GlobalPlaneParams& params) : params_(params), parent_{0} {
+  params_.validate();
+}
+
+std::vector<LocalObservation> GlobalPlaneTable::observe(const PlaneSegmentation& seg, const DepthImage& depth,
+                                                        const Intrinsics& K, const Eigen::Isometry3f& T_wc) const {
+  if (!seg.labels.same_size(depth) || depth.width() != K.width || depth.height() != K.height)
+    throw std::invalid_argument("GlobalPlaneTable::observe: labels, depth and intrinsics differ in size");
+  std::vector<LocalObservation> out(seg.planes.size());
+  for (size_t i = 0; i < seg.planes.size(); ++i) {
+    out[i].local_id = seg.planes[i].id;
+    out[i].plane = seg.planes[i].plane.transformed(T_wc);
+    out[i].centroid = T_wc * seg.planes[i].centroid;
+    out[i].points.reserve(size_t(seg.planes[i].pixels / (params_.point_stride * params_.point_stride) + 16));
+  }
+  const int s = params_.point_stride;
+  for (int v = 0; v < depth.height(); v += s)
+    for (int u = 0; u < depth.width(); u += s) {
+      const int id = seg.labels(u, v);
+      if (id == 0 || id > int(out.size())) continue;
+      out[size_t(id - 1)].points.push_back(T_wc * K.unproject(float(u), float(v), depth(u, v)));
+    }
+  return out;
+}
+
+bool GlobalPlaneTable::geometric_match(const Plane& a, const Eigen::Vector3f& centroid_b) const {
+  // Only plane a's normal is compared here; callers pass both orders where symmetry matters.
+  return std::abs(a.signed_distance(centroid_b)) <= params_.max_distance;
+}
+
+std::vector<CandidateScore> GlobalPlaneTable::score(const LocalObservation& obs, int64_t frame) const {
+  const float cos_max = std::cos(params_.max_normal_angle_deg * std::numbers::pi_v<float> / 180.0f);
+  std::vector<CandidateScore> out;
+  for (const GlobalPlane& g : planes_) {
+    if (!g.alive || g.plane.n.dot(obs.plane.n) < cos_max || !geometric_match(g.plane, obs.centroid)) continue;
+    Footprint local(g.footprint.basis(), params_.cell_size);
+    local.add_points(obs.points);
+    CandidateScore s;
+    s.global_id = g.id;
+    s.overlap = g.footprint.overlap_ratio(local);
+    s.iou = box_iou(g.footprint.box(), local.box());
+    s.gap = box_gap(g.footprint.box(), local.box());
+    s.recent = frame - g.last_seen <= params_.recent_frames;
+    s.matched = s.overlap > params_.min_overlap || s.iou > params_.min_iou || (s.recent && s.gap < params_.max_gap);
+    out.push_back(s);
+  }
+  return out;
+}
+
+void GlobalPlaneTable::absorb(GlobalPlane& g, const LocalObservation& obs, int64_t frame) {
+  for (const Eigen::Vector3f& p : obs.points) g.moments.add(p);
+  const PlaneFit fit = fit_plane(g.moments);
+  if (fit.valid) {
+    g.plane = fit.plane;
+    if (g.plane.n.dot(obs.plane.n) < 0) g.plane = {-g.plane.n, -g.plane.d};  // keep the observed side
+    g.centroid = fit.centroid;
+  }
+  g.footprint.add_points(obs.points);
+  g.last_seen = std::max(g.last_seen, frame);
+  ++g.observations;
+}
+
+int GlobalPlaneTable::create(const LocalObservation& obs, int64_t frame) {
+  GlobalPlane g;
+  g.id = int(planes_.size()) + 1;
+  g.plane = obs.plane;
+  g.centroid = obs.centroid;
+  g.footprint = Footprint(PlaneBasis::from_plane(obs.plane, obs.centroid), params_.cell_size);
+  g.first_seen = g.last_seen = frame;
+  planes_.push_back(std::move(g));
+  parent_.push_back(planes_.back().id);
+  absorb(planes_.back(), obs, frame);
+  planes_.back().plane.n = planes_.back().plane.n.normalized();
+  return planes_.back().id;
+}
+
+FrameAssociation GlobalPlaneTable::associate(std::span<const LocalObservation> observations, int64_t frame) {
+  FrameAssociation out;
+  int max_local = 0;
+  for (const auto& o : observations) max_local = std::max(max_local, o.local_id);
+  out.local_to_global.assign(size_t(max_local) + 1, 0);
+  std::vector<int> touched;
+  for (const LocalObservation& obs : observations) {
+    if (obs.points.size() < 3) continue;
+    const std::vector<CandidateScore> scores = score(obs, frame);
+    const CandidateScore* best = nullptr;
+    for (const CandidateScore& s : scores) {
+      if (!s.matched) continue;
+      if (!best || s.overlap > best->overlap || (s.overlap == best->overlap && s.iou > best->iou) ||
+          (s.overlap == best->overlap && s.iou == best->iou && s.gap < best->gap))
+        best = &s;
+    }
+    int id = 0;
+    if (best) {
+      id = best->global_id;
+      absorb(planes_[size_t(id - 1)], obs, frame);
+    } else {
+      id = create(obs, frame);
+      ++out.created;
+    }
+    out.local_to_global[size_t(obs.local_id)] = id;
+    if (std::find(touched.begin(), touched.end(), id) == touched.end()) touched.push_back(id);
+  }
+  merge_pass(touched, out);
+  for (int& id : out.local_to_global) id = id > 0 ? canonical(id) : 0;
+  return out;
+}
+
+void GlobalPlaneTable::merge_pass(std::span<const int> touched, FrameAssociation& out) {
+  const float cos_max = std::cos(params_.max_normal_angle_deg * std::numbers::pi_v<float> / 180.0f);
+  for (int t : touched) {
+    for (bool changed = true; changed;) {
+      changed = false;
+      const int a = canonical(t);
+      for (const GlobalPlane& other : planes_) {
+        const GlobalPlane& ga = planes_[size_t(a - 1)];
+        if (!other.alive || other.id == a || ga.plane.n.dot(other.plane.n) < cos_max) continue;
+        if (!geometric_match(ga.plane, other.centroid) || !geometric_match(other.plane, ga.centroid)) continue;
+        // Both footprints in a's basis; the smaller one's cells inside the larger one, dilated.
+        Footprint b_in_a(ga.footprint.basis(), params_.cell_size);
+        b_in_a.merge(other.footprint);
+        const float ratio = ga.footprint.cells() >= b_in_a.cells() ? ga.footprint.overlap_ratio(b_in_a)
+                                                                    : b_in_a.overlap_ratio(ga.footprint);
+        if (ratio <= params_.merge_min_overlap) continue;
+        const int kept = std::min(a, other.id), gone = std::max(a, other.id);
+        merge(kept, gone);
+        out.merges.emplace_back(kept, gone);
+        changed = true;
+        break;
+      }
+    }
+  }
+}
+
+bool GlobalPlaneTable::merge(int a, int b) {
+  const int ra = canonical(a), rb = canonical(b);
+  if (ra == rb || ra <= 0 || rb <= 0 || ra > int(planes_.size()) || rb > int(planes_.size())) return false;
+  const int kept = std::min(ra, rb), gone = std::max(ra, rb);
+  GlobalPlane& k = planes_[size_t(kept - 1)];
+  GlobalPlane& g = planes_[size_t(gone - 1)];
+  const Eigen::Vector3f side = k.plane.n;
+  k.moments.merge(g.moments);
+  const PlaneFit fit = fit_plane(k.moments);
+  if (fit.valid) {
+    k.plane = fit.plane;
+    if (k.plane.n.dot(side) < 0) k.plane = {-k.plane.n, -k.plane.d};
+    k.centroid = fit.centroid;
+  }
+  k.footprint.merge(g.footprint);
+  k.first_seen = std::min(k.first_seen, g.first_seen);
+  k.last_seen = std::max(k.last_seen, g.last_seen);
+  k.observations += g.observations;
+  g.alive = false;
+  parent_[size_t(gone)] = kept;
+  return true;
+}
+
+int GlobalPlaneTable::canonical(int id) const {
+  if (id <= 0 || id >= int(parent_.size())) return id;
+  int r = id;
+  while (parent_[size_t(r)] != r) r = parent_[size_t(r)];
+  while (parent_[size_t(id)] != r) {  // path compression
+    const int next = parent_[size_t(id)];
+    parent_[size_t(id)] = r;
+    id = next;
+  }
+  return r;
+}
+
+std::vector<int32_t> GlobalPlaneTable::remap_table() const {
+  std::vector<int32_t> table(parent_.size());
+  for (size_t i = 0; i < table.size(); ++i) table[i] = canonical(int(i));
+  return table;
+}
+
+Image<int32_t> GlobalPlaneTable::global_map(const LabelImage& local_labels, const FrameAssociation& assoc) const {
+  Image<int32_t> out(local_labels.width(), local_labels.height(), 0);
+  for (size_t i = 0; i < local_labels.size(); ++i) {
+    const size_t l = local_labels[i];
+    if (l > 0 && l < assoc.local_to_global.size()) out[i] = canonical(assoc.local_to_global[l]);
+  }
+  return out;
+}
+
+const GlobalPlane* GlobalPlaneTable::find(int id) const {
+  const int r = canonical(id);
+  return r >= 1 && r <= int(planes_.size()) ? &planes_[size_t(r - 1)] : nullptr;
+}
+
+std::vector<int> GlobalPlaneTable::live_ids() const {
+  std::vector<int> ids;
+  for (const GlobalPlane& g : planes_)
+    if (g.alive) ids.push_back(g.id);
+  return ids;
+}
+
+}  // namespace rrg

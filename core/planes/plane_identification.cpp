@@ -1,0 +1,120 @@
+#include "core/planes/plane_identification.h"
+
+#include <spdlog/fmt/fmt.h>
+
+#include <chrono>
+#include <map>
+#include <stdexcept>
+
+namespace rrg {
+
+namespace {
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+}  // namespace
+
+void IdentificationParams::validate() const {
+  segmentation.validate();
+  table.validate();
+  vote.validate();
+  if (!(variance_threshold >= 0)) throw std::invalid_argument("IdentificationParams: variance_threshold must be >= 0");
+  if (!(area_threshold >= 0 && area_threshold < 1))
+    throw std::invalid_argument("IdentificationParams: area_threshold must be in [0, 1)");
+  if (!(min_mask_overlap >= 0 && min_mask_overlap <= 1))
+    throw std::invalid_argument("IdentificationParams: min_mask_overlap must be in [0, 1]");
+}
+
+PlaneIdentifier::PlaneIdentifier(const IdentificationParams& params, std::unique_ptr<SemanticCue> cue)
+    : params_(params), cue_(std::move(cue)), table_(params.table), vote_(params.vote) {
+  params_.validate();
+  if (!cue_) throw std::invalid_argument("PlaneIdentifier: no semantic cue");
+}
+
+IdentificationResult PlaneIdentifier::identify(const IdentificationFrame& frame, const Image<float>& color_variance) {
+  if (!frame.depth || !frame.color) throw std::invalid_argument("PlaneIdentifier::identify: depth and colour are required");
+  const DepthImage& depth = *frame.depth;
+  if (!depth.same_size(*frame.color) || !depth.same_size(color_variance))
+    throw std::invalid_argument(fmt::format("PlaneIdentifier::identify: depth {}x{}, colour {}x{} and C_var {}x{} differ",
+                                            depth.width(), depth.height(), frame.color->width(), frame.color->height(),
+                                            color_variance.width(), color_variance.height()));
+  const auto t_start = std::chrono::steady_clock::now();
+  IdentificationResult out;
+
+  auto t0 = std::chrono::steady_clock::now();
+  out.segmentation = segment_planes(depth, frame.K, params_.segmentation);
+  out.timings.segment_ms = ms_since(t0);
+
+  t0 = std::chrono::steady_clock::now();
+  const auto observations = table_.observe(out.segmentation, depth, frame.K, frame.T_wc);
+  out.association = table_.associate(observations, frame.index);
+  for (const auto& [kept, gone] : out.association.merges) vote_.merge(kept, gone);
+  out.global_map = table_.global_map(out.segmentation.labels, out.association);
+  out.remap = table_.remap_table();
+  out.timings.associate_ms = ms_since(t0);
+
+  t0 = std::chrono::steady_clock::now();
+  const std::vector<SemanticMask> masks = cue_->segment({frame.color, frame.labels, frame.index});
+  for (const SemanticMask& m : masks)
+    if (!m.mask.same_size(depth)) throw std::runtime_error("semantic cue " + cue_->name() + ": mask size differs from the frame");
+  // Per global plane: pixels, pixels above δ_v, and overlap with every mask.
+  struct Stats {
+    int64_t pixels = 0, high_variance = 0;
+    double variance_sum = 0;
+    std::vector<int64_t> overlap;
+  };
+  std::map<int, Stats> stats;
+  for (size_t i = 0; i < out.global_map.size(); ++i) {
+    const int id = out.global_map[i];
+    if (id == 0) continue;
+    Stats& s = stats[id];
+    if (s.overlap.empty()) s.overlap.assign(masks.size(), 0);
+    ++s.pixels;
+    if (color_variance[i] > params_.variance_threshold) ++s.high_variance;
+    s.variance_sum += color_variance[i];
+    for (size_t m = 0; m < masks.size(); ++m) s.overlap[m] += masks[m].mask[i] ? 1 : 0;
+  }
+  std::map<int, int> plane_mask;  // global id -> associated mask index (-1 = none)
+  for (auto& [id, s] : stats) {
+    int best = -1;
+    for (size_t m = 0; m < masks.size(); ++m)
+      if (s.overlap[m] > 0 && (best < 0 || s.overlap[m] > s.overlap[size_t(best)])) best = int(m);
+    if (best >= 0 && double(s.overlap[size_t(best)]) < params_.min_mask_overlap * double(s.pixels)) best = -1;
+    plane_mask[id] = best;
+  }
+  out.timings.semantic_ms = ms_since(t0);
+
+  t0 = std::chrono::steady_clock::now();
+  const int64_t window = window_++;
+  out.reflection_mask = MaskImage(depth.width(), depth.height(), 0);
+  std::vector<int> confirmed_masks;
+  std::vector<int> confirmed_planes;
+  for (const auto& [id, s] : stats) {
+    PlaneVerdict v;
+    v.global_id = id;
+    v.pixels = s.pixels;
+    const int m = plane_mask[id];
+    if (m >= 0) v.label = masks[size_t(m)].label;
+    v.candidate = cue_->every_plane_is_candidate() || (m >= 0 && masks[size_t(m)].reflective);
+    v.variance_fraction = s.pixels > 0 ? float(double(s.high_variance) / double(s.pixels)) : 0.0f;
+    v.variance_mean = s.pixels > 0 ? float(s.variance_sum / double(s.pixels)) : 0.0f;
+    v.reflective_now = v.candidate && v.variance_fraction > params_.area_threshold;
+    v.accepted = vote_.record(id, window, v.reflective_now);
+    if (v.accepted) {
+      if (m >= 0 && !cue_->every_plane_is_candidate()) confirmed_masks.push_back(m);
+      else confirmed_planes.push_back(id);
+    }
+    out.planes.push_back(v);
+  }
+  for (size_t i = 0; i < out.reflection_mask.size(); ++i) {
+    bool on = false;
+    for (int m : confirmed_masks) on = on || masks[size_t(m)].mask[i] != 0;
+    for (int id : confirmed_planes) on = on || out.global_map[i] == id;
+    out.reflection_mask[i] = on ? 1 : 0;
+  }
+  out.timings.verify_ms = ms_since(t0);
+  out.timings.total_ms = ms_since(t_start);
+  return out;
+}
+
+}  // namespace rrg

@@ -1,0 +1,92 @@
+#pragma once
+// One reflective plane identification step (paper §4.1.3), run every N_p = 10 frames:
+//   CAPE-class segmentation -> global plane table (I_k^g) -> semantic cue (candidates: each plane's
+//   largest-overlap mask, reflective label) -> colour-variance verification on the raycast C_var
+//   (fraction of the plane's pixels with C_var > δ_v = 0.01 above δ_area = 0.05) -> 5-window vote
+//   (L_ref) -> predicted reflection mask (the semantic masks of confirmed planes; their plane
+//   masks with the `none` cue).
+// C_var comes from the TSDF raycast of the same pose (core/tsdf/tsdf_raycast.h) and is a plain
+// input here. CPU only, like CAPE.
+#include "core/common/camera.h"
+#include "core/common/image.h"
+#include "core/planes/global_plane_table.h"
+#include "core/planes/plane_segmentation.h"
+#include "core/planes/reflective_vote.h"
+#include "core/planes/semantic_cue.h"
+
+#include <Eigen/Geometry>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace rrg {
+
+struct IdentificationParams {
+  PlaneSegmentationParams segmentation;
+  GlobalPlaneParams table;
+  ReflectiveVoteParams vote;
+  float variance_threshold = 0.01f;  // δ_v on C_var
+  float area_threshold = 0.05f;      // δ_area: fraction of the plane's pixels above δ_v
+  float min_mask_overlap = 0.3f;     // a plane takes its largest-overlap mask only when the mask
+                                     // covers at least this fraction of the plane's pixels
+  void validate() const;             // throws std::invalid_argument
+};
+
+struct IdentificationFrame {
+  const DepthImage* depth = nullptr;      // D_k, metres
+  const ColorImage* color = nullptr;      // C_k
+  const LabelImage* labels = nullptr;     // optional per-pixel categories (labels cue)
+  Intrinsics K;
+  Eigen::Isometry3f T_wc = Eigen::Isometry3f::Identity();
+  int64_t index = 0;                      // frame index
+};
+
+struct PlaneVerdict {
+  int global_id = 0;             // canonical
+  int64_t pixels = 0;            // in this frame's I_k^g
+  std::string label;             // associated mask's label ("" when none)
+  bool candidate = false;        // reflective-plane candidate (geometric + semantic cue)
+  float variance_fraction = 0;   // fraction of its pixels with C_var > δ_v
+  float variance_mean = 0;       // mean C_var over its pixels (for logs)
+  bool reflective_now = false;   // passed the variance check in this window
+  bool accepted = false;         // in L_ref after this window
+};
+
+struct IdentificationTimings {
+  double segment_ms = 0, associate_ms = 0, semantic_ms = 0, verify_ms = 0, total_ms = 0;
+};
+
+struct IdentificationResult {
+  PlaneSegmentation segmentation;    // local planes and map
+  FrameAssociation association;
+  Image<int32_t> global_map;         // I_k^g, canonical global ids, 0 = none
+  std::vector<PlaneVerdict> planes;  // one per global plane present in the frame
+  MaskImage reflection_mask;         // predicted reflection mask (0 / 1)
+  std::vector<int32_t> remap;        // id -> canonical id, for TSDF fusion and raycast
+  IdentificationTimings timings;
+};
+
+class PlaneIdentifier {
+ public:
+  // Throws std::invalid_argument for bad params or a null cue.
+  PlaneIdentifier(const IdentificationParams& params, std::unique_ptr<SemanticCue> cue);
+
+  // One step. color_variance is C_var at the frame's pose (K's size; pixels without a surface 0).
+  IdentificationResult identify(const IdentificationFrame& frame, const Image<float>& color_variance);
+
+  const GlobalPlaneTable& table() const { return table_; }
+  const ReflectiveVote& vote() const { return vote_; }
+  const SemanticCue& cue() const { return *cue_; }
+  const IdentificationParams& params() const { return params_; }
+  int64_t windows() const { return window_; }
+
+ private:
+  IdentificationParams params_;
+  std::unique_ptr<SemanticCue> cue_;
+  GlobalPlaneTable table_;
+  ReflectiveVote vote_;
+  int64_t window_ = 0;
+};
+
+}  // namespace rrg

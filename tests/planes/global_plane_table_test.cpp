@@ -1,0 +1,201 @@
+// The global plane table: geometric filter, footprint overlap / bbox IoU / gap rules, best-overlap
+// choice, union-find merges and the remap table, each on hand-made floor patches (world z = 0).
+#include "core/planes/global_plane_table.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace rrg {
+namespace {
+
+// A rectangle [x0, x1] x [y0, y1] of points every 1 cm on the plane z = h (normal +z).
+LocalObservation patch(int local_id, float x0, float x1, float y0, float y1, float h = 0.0f) {
+  LocalObservation o;
+  o.local_id = local_id;
+  o.plane = {Eigen::Vector3f::UnitZ(), -h};
+  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+  const int nx = int(std::lround((x1 - x0) / 0.01f)), ny = int(std::lround((y1 - y0) / 0.01f));
+  for (int i = 0; i <= nx; ++i)
+    for (int j = 0; j <= ny; ++j) {
+      o.points.emplace_back(x0 + 0.01f * float(i), y0 + 0.01f * float(j), h);
+      sum += o.points.back();
+    }
+  o.centroid = sum / float(o.points.size());
+  return o;
+}
+
+int associate_one(GlobalPlaneTable& t, const LocalObservation& o, int64_t frame) {
+  const LocalObservation obs[] = {o};
+  return t.associate(obs, frame).local_to_global.at(size_t(o.local_id));
+}
+
+TEST(GlobalPlaneTable, OverlapRuleMatchesAndUpdatesFootprint) {
+  GlobalPlaneTable t;
+  EXPECT_EQ(associate_one(t, patch(1, 0, 1, 0, 1), 0), 1);
+  const size_t cells_before = t.find(1)->footprint.cells();
+  EXPECT_EQ(associate_one(t, patch(1, 0.5f, 1.5f, 0, 1), 100), 1);  // half overlapping, long after
+  EXPECT_GT(t.find(1)->footprint.cells(), cells_before);
+  const Box2& box = t.find(1)->footprint.box();
+  EXPECT_NEAR(box.max.x() - box.min.x(), 1.5f, 0.011f);  // the box grew to cover both patches
+  EXPECT_EQ(t.live_ids().size(), 1u);
+  EXPECT_EQ(t.find(1)->observations, 2);
+}
+
+TEST(GlobalPlaneTable, GeometricFilterRejectsDistanceAndAngle) {
+  GlobalPlaneTable t;
+  associate_one(t, patch(1, 0, 1, 0, 1), 0);
+  EXPECT_EQ(associate_one(t, patch(1, 0, 1, 0, 1, 0.15f), 1), 2);  // 15 cm above: new instance
+  EXPECT_EQ(associate_one(t, patch(1, 0, 1, 0, 1, 0.08f), 2), 1);  // 8 cm: same instance as the first
+  LocalObservation tilted = patch(1, 0, 1, 0, 1);
+  const Eigen::AngleAxisf r(15.0f * 3.14159265f / 180.0f, Eigen::Vector3f::UnitX());
+  for (auto& p : tilted.points) p = r * (p - tilted.centroid) + tilted.centroid;
+  tilted.plane = {r * Eigen::Vector3f::UnitZ(), -(r * Eigen::Vector3f::UnitZ()).dot(tilted.centroid)};
+  EXPECT_EQ(associate_one(t, tilted, 3), 3);  // 15° tilt: new instance
+}
+
+TEST(GlobalPlaneTable, BoxIouRuleMatchesWithoutCellOverlap) {
+  GlobalPlaneTable t;
+  // Two small squares at opposite corners of [0, 2]²: one instance (the second matches by IoU).
+  LocalObservation corners = patch(1, 0, 0.2f, 0, 0.2f);
+  const LocalObservation far = patch(1, 1.8f, 2.0f, 1.8f, 2.0f);
+  corners.points.insert(corners.points.end(), far.points.begin(), far.points.end());
+  corners.centroid = Eigen::Vector3f(1, 1, 0);
+  ASSERT_EQ(associate_one(t, corners, 0), 1);
+  // Middle square 0.4 x 0.4: no cell overlap, IoU = 0.16 / 4 = 0.04 > 0.02, not recent (frame 500).
+  const LocalObservation middle = patch(1, 0.8f, 1.2f, 0.8f, 1.2f);
+  const auto scores = t.score(middle, 500);
+  ASSERT_EQ(scores.size(), 1u);
+  EXPECT_EQ(scores[0].overlap, 0.0f);
+  EXPECT_NEAR(scores[0].iou, 0.04f, 0.005f);
+  EXPECT_FALSE(scores[0].recent);
+  EXPECT_TRUE(scores[0].matched);
+  // A 0.1 x 0.1 square away from the corners and the middle has IoU 0.0025, is not recent: new.
+  EXPECT_EQ(associate_one(t, patch(1, 0.3f, 0.4f, 1.5f, 1.6f), 500), 2);
+  EXPECT_EQ(associate_one(t, middle, 501), 1);
+}
+
+TEST(GlobalPlaneTable, GapRuleOnlyForRecentInstances) {
+  GlobalPlaneParams params;
+  params.recent_frames = 30;
+  {
+    GlobalPlaneTable t(params);
+    associate_one(t, patch(1, 0, 0.99f, 0, 1), 0);
+    const LocalObservation beside = patch(1, 1.07f, 2.0f, 0, 1);  // 8 cm gap
+    const auto s = t.score(beside, 10);
+    ASSERT_EQ(s.size(), 1u);
+    EXPECT_EQ(s[0].overlap, 0.0f);
+    EXPECT_EQ(s[0].iou, 0.0f);
+    EXPECT_NEAR(s[0].gap, 0.08f, 0.002f);
+    EXPECT_EQ(associate_one(t, beside, 10), 1);  // seen 10 frames ago: recent
+  }
+  {
+    GlobalPlaneTable t(params);
+    associate_one(t, patch(1, 0, 0.99f, 0, 1), 0);
+    EXPECT_EQ(associate_one(t, patch(1, 1.07f, 2.0f, 0, 1), 100), 2);  // 100 frames later: new
+  }
+  {
+    GlobalPlaneTable t(params);
+    associate_one(t, patch(1, 0, 0.99f, 0, 1), 0);
+    EXPECT_EQ(associate_one(t, patch(1, 1.15f, 2.0f, 0, 1), 10), 2);  // 16 cm gap: new
+  }
+}
+
+TEST(GlobalPlaneTable, BestOverlapWinsAmongMatchingCandidates) {
+  GlobalPlaneTable t;
+  associate_one(t, patch(1, 0, 1, 0, 1), 0);        // id 1
+  associate_one(t, patch(1, 1.5f, 2.5f, 0, 1), 0);  // id 2 (gap 0.5 m)
+  ASSERT_EQ(t.live_ids().size(), 2u);
+  const LocalObservation bridge = patch(1, 0.9f, 2.5f, 0, 1);
+  const auto scores = t.score(bridge, 1);
+  ASSERT_EQ(scores.size(), 2u);
+  EXPECT_TRUE(scores[0].matched && scores[1].matched);
+  EXPECT_GT(scores[1].overlap, scores[0].overlap);
+  const LocalObservation obs[] = {bridge};
+  const FrameAssociation a = t.associate(obs, 1);
+  EXPECT_EQ(a.local_to_global[1], 2);  // the higher overlap, not a bridge of both
+  EXPECT_TRUE(a.merges.empty());
+  EXPECT_EQ(t.live_ids().size(), 2u);
+}
+
+TEST(GlobalPlaneTable, UnionFindMergeLowerIdAbsorbsHigherAndRemaps) {
+  GlobalPlaneTable t;
+  associate_one(t, patch(1, 0, 1, 0, 1), 0);                 // 1
+  associate_one(t, patch(1, 3, 4, 0, 1), 0);                 // 2: far away, no rule matches
+  associate_one(t, patch(1, 6, 7, 0, 1), 0);                 // 3
+  ASSERT_EQ(t.live_ids(), (std::vector<int>{1, 2, 3}));
+  const size_t cells = t.find(1)->footprint.cells() + t.find(2)->footprint.cells() + t.find(3)->footprint.cells();
+  EXPECT_TRUE(t.merge(3, 2));
+  EXPECT_EQ(t.canonical(3), 2);
+  EXPECT_TRUE(t.merge(2, 1));
+  EXPECT_FALSE(t.merge(1, 3));  // already one instance
+  EXPECT_EQ(t.canonical(3), 1);
+  EXPECT_EQ(t.remap_table(), (std::vector<int32_t>{0, 1, 1, 1}));
+  EXPECT_EQ(t.live_ids(), (std::vector<int>{1}));
+  const GlobalPlane* g = t.find(3);
+  ASSERT_NE(g, nullptr);
+  EXPECT_EQ(g->id, 1);
+  EXPECT_EQ(g->footprint.cells(), cells);
+  EXPECT_NEAR(g->footprint.box().min.x() - g->footprint.box().max.x(), -7.0f, 0.02f);  // spans x 0..7
+  EXPECT_NEAR(std::abs(g->plane.n.z()), 1.0f, 1e-5f);
+  EXPECT_NEAR(g->plane.d, 0.0f, 1e-4f);
+  EXPECT_NEAR(g->centroid.x(), 3.5f, 0.01f);
+  // The global map goes through the remap table.
+  LabelImage local(2, 1, 0);
+  local(0, 0) = 1;
+  FrameAssociation a;
+  a.local_to_global = {0, 3};
+  const Image<int32_t> map = t.global_map(local, a);
+  EXPECT_EQ(map(0, 0), 1);
+  EXPECT_EQ(map(1, 0), 0);
+}
+
+TEST(GlobalPlaneTable, MergePassJoinsInstancesThatTurnOutToBeOnePlane) {
+  GlobalPlaneTable t;
+  associate_one(t, patch(1, 0, 1, 0, 1), 0);  // 1
+  associate_one(t, patch(1, 3, 4, 0, 1), 0);  // 2
+  // Later the whole floor is seen at once: it matches both, grows one, and the instances merge.
+  const LocalObservation all[] = {patch(1, 0, 4, 0, 1)};
+  const FrameAssociation a = t.associate(all, 50);
+  ASSERT_EQ(a.merges.size(), 1u);
+  EXPECT_EQ(a.merges[0], std::make_pair(1, 2));
+  EXPECT_EQ(a.local_to_global[1], 1);
+  EXPECT_EQ(t.canonical(2), 1);
+}
+
+TEST(GlobalPlaneTable, ObserveTransformsPlanesToWorld) {
+  // One local plane: the camera looks down +z at a wall 2 m away; camera 1 m up the world x axis.
+  const Intrinsics K{100, 100, 9.5f, 9.5f, 20, 20};
+  PlaneSegmentation seg;
+  seg.labels = LabelImage(20, 20, 1);
+  LocalPlane lp;
+  lp.id = 1;
+  lp.plane = {Eigen::Vector3f(0, 0, -1), 2.0f};
+  lp.centroid = Eigen::Vector3f(0, 0, 2);
+  lp.pixels = 400;
+  seg.planes = {lp};
+  const DepthImage depth(20, 20, 2.0f);
+  Eigen::Isometry3f T_wc = Eigen::Isometry3f::Identity();
+  T_wc.translation() = Eigen::Vector3f(1, 0, 0);
+  GlobalPlaneTable t;
+  const auto obs = t.observe(seg, depth, K, T_wc);
+  ASSERT_EQ(obs.size(), 1u);
+  EXPECT_EQ(obs[0].points.size(), 100u);  // stride 2
+  EXPECT_NEAR(obs[0].plane.signed_distance(Eigen::Vector3f(5, 3, 2)), 0.0f, 1e-5f);
+  EXPECT_NEAR(obs[0].centroid.x(), 1.0f, 1e-5f);
+  for (const auto& p : obs[0].points) EXPECT_NEAR(p.z(), 2.0f, 1e-5f);
+}
+
+TEST(GlobalPlaneTable, BadParamsThrowNamingTheField) {
+  GlobalPlaneParams p;
+  p.cell_size = 0;
+  try {
+    GlobalPlaneTable t(p);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("cell_size"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace rrg

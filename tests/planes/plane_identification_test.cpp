@@ -1,0 +1,134 @@
+// One identification step end to end on analytic frames: floor + wall seen by a fixed camera, a
+// stand-in C_var (high on 10% of the floor pixels, 0 elsewhere; unit-test input only), the labels
+// and none cues, and the 5-window vote.
+#include "core/planes/plane_identification.h"
+#include "core/planes/semantic_labels.h"
+
+#include <gtest/gtest.h>
+
+namespace rrg {
+namespace {
+
+struct Scene {
+  Intrinsics K{256.0f, 256.0f, 159.5f, 119.5f, 320, 240};
+  DepthImage depth;
+  ColorImage color;
+  LabelImage labels;  // 1 floor, 2 wall
+  Image<float> cvar;
+};
+
+Scene make_scene() {
+  Scene s;
+  s.depth = DepthImage(320, 240, 0.0f);
+  s.color = ColorImage(320, 240, Color(0.5f, 0.5f, 0.5f));
+  s.labels = LabelImage(320, 240, 0);
+  s.cvar = Image<float>(320, 240, 0.0f);
+  for (int v = 0; v < 240; ++v)
+    for (int u = 0; u < 320; ++u) {
+      const Eigen::Vector3f ray((u - 159.5f) / 256.0f, (v - 119.5f) / 256.0f, 1.0f);
+      const float z_wall = 4.0f;                                         // wall z = 4
+      const float z_floor = ray.y() > 1e-6f ? 1.0f / ray.y() : 1e9f;     // floor y = 1
+      const bool floor = z_floor < z_wall;
+      s.depth(u, v) = floor ? z_floor : z_wall;
+      s.labels(u, v) = floor ? 1 : 2;
+      if (floor && (u % 10) == 0) s.cvar(u, v) = 0.05f;  // 10% of the floor above δ_v
+    }
+  return s;
+}
+
+CategoryTable table() {
+  CategoryTable t;
+  t.names = {{1, "floor"}, {2, "wall"}};
+  return t;
+}
+
+// Runs `windows` identification steps and returns the last result.
+IdentificationResult run(PlaneIdentifier& id, const Scene& s, int windows) {
+  IdentificationResult r;
+  for (int w = 0; w < windows; ++w)
+    r = id.identify({&s.depth, &s.color, &s.labels, s.K, Eigen::Isometry3f::Identity(), int64_t(w) * 10}, s.cvar);
+  return r;
+}
+
+const PlaneVerdict& verdict_for_label(const IdentificationResult& r, const Scene& s, uint16_t label) {
+  // the global plane under a pixel of that label
+  for (size_t i = 0; i < s.labels.size(); ++i)
+    if (s.labels[i] == label && r.global_map[i] != 0)
+      for (const auto& v : r.planes)
+        if (v.global_id == r.global_map[i]) return v;
+  throw std::runtime_error("no plane for label");
+}
+
+TEST(PlaneIdentification, LabelsCueAcceptsTheVaryingFloorAfterFourWindows) {
+  const Scene s = make_scene();
+  PlaneIdentifier id({}, make_label_semantics(table(), paper_prompts()));
+  IdentificationResult r = run(id, s, 3);
+  ASSERT_EQ(r.segmentation.planes.size(), 2u);
+  ASSERT_EQ(r.planes.size(), 2u);
+  const PlaneVerdict& floor = verdict_for_label(r, s, 1);
+  const PlaneVerdict& wall = verdict_for_label(r, s, 2);
+  EXPECT_EQ(floor.label, "floor");
+  EXPECT_TRUE(floor.candidate);
+  EXPECT_NEAR(floor.variance_fraction, 0.1f, 0.02f);
+  EXPECT_TRUE(floor.reflective_now);
+  EXPECT_FALSE(floor.accepted);  // 3 windows: not yet
+  EXPECT_EQ(wall.label, "wall");
+  EXPECT_FALSE(wall.candidate);
+  EXPECT_FALSE(wall.reflective_now);
+  for (uint8_t m : r.reflection_mask.pixels()) ASSERT_EQ(m, 0);
+
+  r = run(id, s, 1);  // fourth window
+  EXPECT_TRUE(verdict_for_label(r, s, 1).accepted);
+  EXPECT_FALSE(verdict_for_label(r, s, 2).accepted);
+  EXPECT_EQ(id.vote().lookup_table().size(), 1u);
+  // The predicted mask is the floor's semantic mask.
+  for (size_t i = 0; i < s.labels.size(); ++i) ASSERT_EQ(r.reflection_mask[i], s.labels[i] == 1 ? 1 : 0) << i;
+  // Global ids stay the same across windows; the remap table is the identity.
+  EXPECT_EQ(id.table().live_ids().size(), 2u);
+  EXPECT_EQ(r.remap, (std::vector<int32_t>{0, 1, 2}));
+}
+
+TEST(PlaneIdentification, NoneCueLetsVarianceDecide) {
+  const Scene s = make_scene();
+  PlaneIdentifier id({}, make_no_semantics());
+  const IdentificationResult r = run(id, s, 4);
+  const PlaneVerdict& floor = verdict_for_label(r, s, 1);
+  const PlaneVerdict& wall = verdict_for_label(r, s, 2);
+  EXPECT_TRUE(floor.candidate && wall.candidate);
+  EXPECT_TRUE(floor.accepted);
+  EXPECT_FALSE(wall.accepted);
+  // The mask is the floor's plane mask.
+  for (size_t i = 0; i < s.labels.size(); ++i)
+    ASSERT_EQ(r.reflection_mask[i], r.global_map[i] == floor.global_id ? 1 : 0);
+}
+
+TEST(PlaneIdentification, NonReflectiveCategoryIsNeverACandidate) {
+  const Scene s = make_scene();
+  PlaneIdentifier id({}, make_label_semantics(table(), {"tv"}));
+  const IdentificationResult r = run(id, s, 6);
+  EXPECT_FALSE(verdict_for_label(r, s, 1).candidate);
+  EXPECT_TRUE(id.vote().lookup_table().empty());
+}
+
+TEST(PlaneIdentification, LowVarianceBelowAreaThresholdIsRejected) {
+  Scene s = make_scene();
+  for (size_t i = 0; i < s.cvar.size(); ++i)  // keep only every 5th high pixel: 2% of the floor
+    if (s.cvar[i] > 0 && (i / 10) % 5 != 0) s.cvar[i] = 0.0f;
+  PlaneIdentifier id({}, make_no_semantics());
+  const IdentificationResult r = run(id, s, 5);
+  EXPECT_LT(verdict_for_label(r, s, 1).variance_fraction, 0.05f);
+  EXPECT_TRUE(id.vote().lookup_table().empty());
+}
+
+TEST(PlaneIdentification, InputErrors) {
+  const Scene s = make_scene();
+  EXPECT_THROW(PlaneIdentifier({}, nullptr), std::invalid_argument);
+  PlaneIdentifier id({}, make_no_semantics());
+  EXPECT_THROW(id.identify({&s.depth, &s.color, nullptr, s.K, Eigen::Isometry3f::Identity(), 0}, Image<float>(10, 10)),
+               std::invalid_argument);
+  EXPECT_THROW(id.identify({nullptr, &s.color, nullptr, s.K, Eigen::Isometry3f::Identity(), 0}, s.cvar),
+               std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace rrg

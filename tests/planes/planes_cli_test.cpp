@@ -1,0 +1,76 @@
+// `rrg planes` through the real executable on a tiny synthetic sequence.
+#include "tests/support/test_support.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+
+namespace rrg {
+namespace {
+
+class PlanesCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new test::TempDir("planes_cli");
+    const auto r = test::run_rrg("synth --preset living_room --frames 3 --width 160 --height 120 --novel 0 --out " +
+                                 (dir_->path() / "seq").string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  static void TearDownTestSuite() {
+    delete dir_;  // NOLINT: suite-wide scratch folder
+    dir_ = nullptr;
+  }
+  static std::string seq() { return (dir_->path() / "seq").string(); }
+  static test::TempDir* dir_;
+};
+test::TempDir* PlanesCli::dir_ = nullptr;
+
+std::string json_part(const std::string& output) {
+  const auto a = output.find('{');
+  const auto b = output.rfind('}');
+  return a == std::string::npos ? "{}" : output.substr(a, b - a + 1);
+}
+
+TEST_F(PlanesCli, SegmentPrintsScoresAndWritesMaps) {
+  const auto out = dir_->path() / "maps";
+  const auto r = test::run_rrg("planes segment --dataset " + seq() + " --json --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = nlohmann::json::parse(json_part(r.output));
+  EXPECT_EQ(j["frames"].size(), 3u);
+  EXPECT_GT(j["frames"][0]["planes"].size(), 2u);  // a room: floor, walls, furniture
+  EXPECT_GT(j["precision"].get<double>(), 0.5);
+  EXPECT_GT(j["recall"].get<double>(), 0.5);
+  EXPECT_TRUE(std::filesystem::exists(out / "000002.png"));
+}
+
+TEST_F(PlanesCli, EvalRunsBothCuesWithFusion) {
+  const auto r = test::run_rrg("planes eval --dataset " + seq() + " --semantics none,labels --period 1 --voxel 0.04 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = nlohmann::json::parse(json_part(r.output));
+  EXPECT_EQ(j["frames"].get<int>(), 3);
+  EXPECT_EQ(j["windows"].get<int>(), 3);
+  ASSERT_EQ(j["cues"].size(), 2u);
+  EXPECT_EQ(j["cues"][0]["semantics"], "none");
+  EXPECT_EQ(j["cues"][1]["semantics"], "labels");
+  EXPECT_GT(j["global_planes"].get<int>(), 2);
+  // Three windows are fewer than the four reflective votes L_ref needs.
+  EXPECT_EQ(j["cues"][1]["accepted"].get<int>(), 0);
+}
+
+TEST_F(PlanesCli, ErrorsAndUsage) {
+  auto r = test::run_rrg("planes eval --dataset " + seq() + " --semantics magic");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("unknown semantics 'magic'"), std::string::npos) << r.output;
+  r = test::run_rrg("planes segment --dataset " + (dir_->path() / "nothing").string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("rrg: error:"), std::string::npos);
+  r = test::run_rrg("planes segment");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = test::run_rrg("planes eval --dataset " + seq() + " --semantics remote");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("no segmenter address"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace rrg
