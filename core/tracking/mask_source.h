@@ -1,0 +1,46 @@
+#pragma once
+// Where the tracking mask R_k^track comes from (paper §4.1.2): the reflection image C_r rendered
+// at the ICP pose, R_k^track(u) = mean RGB of C_r(u) > 0.1. Until the Gaussian engine exists the
+// source is pluggable; the synthetic generator's ground-truth reflection masks are one source.
+#include "core/common/image.h"
+
+#include <Eigen/Geometry>
+
+#include <filesystem>
+#include <functional>
+
+namespace rrg {
+
+class MaskSource {
+ public:
+  virtual ~MaskSource() = default;
+  // R_k^track of frame `frame_index` seen from T_wc_icp (non-zero = reflection, no features).
+  virtual MaskImage mask(size_t frame_index, const Eigen::Isometry3f& T_wc_icp) = 0;
+};
+
+// R^track(u) = (C_r,r + C_r,g + C_r,b) / 3 > threshold.
+MaskImage tracking_mask_from_reflection(const ColorImage& reflection_color, float threshold = 0.1f);
+
+// Renders C_r with a callback (the reflection Gaussians, later) and thresholds it.
+class RenderedReflectionMasks final : public MaskSource {
+ public:
+  using Renderer = std::function<ColorImage(size_t frame_index, const Eigen::Isometry3f& T_wc)>;
+  RenderedReflectionMasks(Renderer render, float threshold) : render_(std::move(render)), threshold_(threshold) {}
+  MaskImage mask(size_t frame_index, const Eigen::Isometry3f& T_wc_icp) override;
+
+ private:
+  Renderer render_;
+  float threshold_;
+};
+
+// Ground-truth reflection masks of a synthetic dataset (reflection/NNNNNN.png, core/io/synth_layout.h).
+class SynthReflectionMasks final : public MaskSource {
+ public:
+  explicit SynthReflectionMasks(std::filesystem::path root);  // throws if root/reflection is missing
+  MaskImage mask(size_t frame_index, const Eigen::Isometry3f& T_wc_icp) override;
+
+ private:
+  std::filesystem::path root_;
+};
+
+}  // namespace rrg

@@ -1,0 +1,37 @@
+#pragma once
+// Where ICP's model comes from: a raycast of the map at a pose. Tracking asks for the model at the
+// previous pose T_{k−1} (and at a relocalised pose to verify it). The TSDF source raycasts
+// core/tsdf; tests can serve fixed maps.
+#include "core/tracking/icp.h"
+#include "core/tsdf/tsdf_raycast.h"
+#include "core/tsdf/tsdf_volume.h"
+
+#include <optional>
+
+namespace rrg {
+
+class ModelSource {
+ public:
+  virtual ~ModelSource() = default;
+  // The model seen from T_wc; its images stay valid until the next call.
+  virtual IcpModel model_at(const Eigen::Isometry3f& T_wc) = 0;
+};
+
+// Raycasts a TSDF volume (V*, N* in the world frame) with intrinsics K; the last raycast is kept
+// and reused when asked again for the same pose.
+class TsdfModelSource final : public ModelSource {
+ public:
+  TsdfModelSource(const TsdfVolume& volume, const Intrinsics& K) : volume_(volume), K_(K) {}
+  IcpModel model_at(const Eigen::Isometry3f& T_wc) override;
+  // Forgets the cached raycast (call after fusing a frame).
+  void invalidate() { cached_.reset(); }
+  const RaycastResult* last() const { return cached_ ? &*cached_ : nullptr; }
+
+ private:
+  const TsdfVolume& volume_;
+  Intrinsics K_;
+  std::optional<RaycastResult> cached_;
+  Eigen::Isometry3f cached_T_ = Eigen::Isometry3f::Identity();
+};
+
+}  // namespace rrg

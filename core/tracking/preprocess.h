@@ -1,0 +1,38 @@
+#pragma once
+// Input preprocessing of tracking (paper §4.1.1): optional bilateral filter of D_k, a depth
+// pyramid (2x2 block averages that skip depth discontinuities), and per level the local vertex map
+// V_k^l and normal map N_k^l (core/common/depth_maps.h). Runs on the device the depth lives on.
+#include "core/common/buffer.h"
+#include "core/common/camera.h"
+#include "core/common/depth_maps.h"
+#include "core/tracking/tracking_params.h"
+
+#include <vector>
+
+namespace rrg {
+
+struct PyramidLevel {
+  Intrinsics K;                    // K scaled to this level
+  DeviceImage<float> depth;        // metres, 0 = invalid
+  VertexNormalMaps maps;           // V_k^l, N_k^l (camera frame)
+};
+
+struct FramePyramid {
+  std::vector<PyramidLevel> levels;  // [0] = full resolution
+};
+
+// Bilateral filter (window 2r+1, σ_s pixels, σ_d metres); invalid pixels stay invalid and never
+// contribute.
+DeviceImage<float> bilateral_filter_depth(const DeviceImage<float>& depth, int radius, float sigma_space_px,
+                                          float sigma_depth_m);
+
+// Half resolution: mean of the valid pixels of each 2x2 block within 3σ_d of its top-left pixel.
+DeviceImage<float> downsample_depth(const DeviceImage<float>& depth, float sigma_depth_m);
+
+// Intrinsics of the level downsample_depth() makes from a K-sized image.
+Intrinsics half_intrinsics(const Intrinsics& K, int width, int height);
+
+// The whole preprocessing. Throws std::invalid_argument when depth and K disagree in size.
+FramePyramid build_pyramid(const DeviceImage<float>& depth, const Intrinsics& K, const PreprocessParams& params);
+
+}  // namespace rrg

@@ -1,0 +1,89 @@
+#pragma once
+// Parameters of reflection-aware tracking (paper §4.1.1-4.1.2, DESIGN.md §5) with their defaults,
+// and the ablation switch of the paper's tracking ablation (icp | icp+orb | icp+orb+mask).
+#include <string>
+
+namespace rrg {
+
+// Which stages run: ICP only ("w/o ORB refinement"), ICP + ORB on every pixel ("w/o tracking
+// mask"), or ICP + ORB on the pixels where the tracking mask R_k^track is 0 (the full model).
+enum class TrackingMode { Icp, IcpOrb, IcpOrbMask };
+TrackingMode parse_tracking_mode(const std::string& text);  // "icp" | "icp+orb" | "icp+orb+mask"
+std::string to_string(TrackingMode mode);
+
+struct PreprocessParams {
+  bool bilateral = true;          // bilateral filter on D_k before the vertex/normal maps
+  int bilateral_radius = 3;       // 7x7 window (KinectFusion)
+  float sigma_space_px = 4.5f;    // σ_s, pixels at level 0
+  float sigma_depth_m = 0.03f;    // σ_d, metres
+  int levels = 3;                 // pyramid levels, level l is (w / 2^l) x (h / 2^l)
+};
+
+struct IcpParams {
+  int iterations[3] = {10, 5, 4}; // Gauss-Newton steps per level (0 = finest), coarse to fine
+  float max_distance_m = 0.10f;   // reject pairs farther apart (after the current estimate)
+  float max_normal_angle_deg = 30.0f;  // reject pairs whose normals differ more
+  float huber_delta_m = 0.01f;    // robust weight w = min(1, δ / |r|) on the point-to-plane residual
+  float min_inlier_ratio = 0.25f; // below: ICP failed (diverged or no overlap)
+  float ok_inlier_ratio = 0.50f;  // below (and above min): tracking degraded
+  float max_jump_m = 0.30f;       // an ICP step farther than this from the motion prior diverged
+  float max_jump_deg = 30.0f;
+  float converge_translation_m = 1e-5f;  // stop a level when the update is this small
+  float converge_rotation_rad = 1e-5f;
+};
+
+struct OrbParams {
+  int features = 1000;            // ORB features per frame (OpenCV ORB, 8 levels, factor 1.2)
+  int levels = 8;
+  float scale_factor = 1.2f;
+  float min_depth_m = 0.1f, max_depth_m = 6.0f;  // keypoints need a valid depth to become map points
+  float ratio = 0.8f;             // Lowe ratio test (best / second best Hamming distance)
+  int max_hamming = 64;           // descriptor distance limit (ORB-SLAM2 TH_HIGH = 100, TH_LOW = 50)
+  float search_radius_px = 12.0f; // guided matching: keypoint within this of the projected map point
+  int rotation_bins = 30;         // rotation consistency histogram (keep the 3 fullest bins)
+  int window_keyframes = 5;       // local window of keyframes whose points are matched
+  int min_inliers = 20;           // fewer after BA: keep the ICP pose and say so
+  float max_correction_m = 0.05f; // a BA result farther than this from the ICP pose is rejected
+  float max_correction_deg = 3.0f;
+  float mask_threshold = 0.1f;    // R_k^track = mean RGB of C_r > 0.1
+  float icp_prior_scale = 1e-3f;  // s of the ICP prior Λ = s JᵀJ_icp / σ_icp² in the BA (0 = none);
+                                  // s < 1 because neighbouring ICP residuals are correlated
+  float baseline_fx = 40.0f;      // b·f_x (pixels·m) of the virtual stereo residual (ORB-SLAM2 RGB-D)
+};
+
+struct BaParams {
+  int rounds = 4;                 // ORB-SLAM2 PoseOptimization: 4 rounds of 10 iterations,
+  int iterations = 10;            // outliers re-classified after each round
+  double chi2_mono = 5.991;       // χ²(2 dof, 95 %)
+  double chi2_stereo = 7.815;     // χ²(3 dof, 95 %)
+};
+
+struct KeyframeParams {
+  // ORB map points need views close to the current one, so tracking keyframes are denser than
+  // GPS-SLAM's optimisation keyframes (30°, 0.3 m; DESIGN.md §5): δ_angle = 10°, δ_move = 0.1 m.
+  float delta_angle_deg = 10.0f;
+  float delta_move_m = 0.10f;
+  int max_keyframes = 200;        // oldest dropped beyond (relocalisation searches all kept ones)
+};
+
+struct RelocParams {
+  int ransac_iterations = 200;    // 3-point rigid (3D-3D) hypotheses
+  float inlier_distance_m = 0.05f;
+  int min_inliers = 25;
+  int max_keyframes = 20;         // most recent keyframes tried
+};
+
+struct TrackingParams {
+  TrackingMode mode = TrackingMode::IcpOrbMask;
+  PreprocessParams preprocess;
+  IcpParams icp;
+  OrbParams orb;
+  BaParams ba;
+  KeyframeParams keyframes;
+  RelocParams reloc;
+
+  // Throws std::invalid_argument naming the first bad field.
+  void validate() const;
+};
+
+}  // namespace rrg

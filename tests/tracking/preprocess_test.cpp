@@ -1,0 +1,91 @@
+// Preprocessing (core/tracking/preprocess.h): bilateral filter, depth pyramid, per-level maps.
+#include "core/tracking/preprocess.h"
+#include "tests/support/parity.h"
+#include "tests/tracking/box_scene.h"
+
+#include <gtest/gtest.h>
+
+namespace rrg {
+namespace {
+
+DepthImage image_of(int w, int h, std::initializer_list<float> values) {
+  DepthImage d(w, h);
+  size_t i = 0;
+  for (float v : values) d[i++] = v;
+  return d;
+}
+
+TEST(Preprocess, DownsampleAveragesBlocksAndSkipsDiscontinuities) {
+  // 4x2 -> 2x1. Left block: 1.0, 1.02, 1.04, 0 (invalid) -> mean of the three valid = 1.02.
+  // Right block: 2.0, 3.0 (beyond 3σ_d = 0.09 of the first), 2.06, 2.0 -> mean(2.0, 2.06, 2.0) = 2.02.
+  const DepthImage d = image_of(4, 2, {1.0f, 1.02f, 2.0f, 3.0f, 1.04f, 0.0f, 2.06f, 2.0f});
+  const Image<float> out = downsample_depth(DeviceImage<float>::from_host(d, Device::cpu()), 0.03f).to_host();
+  ASSERT_EQ(out.width(), 2);
+  ASSERT_EQ(out.height(), 1);
+  EXPECT_NEAR(out(0, 0), 1.02f, 1e-6f);
+  EXPECT_NEAR(out(1, 0), 2.02f, 1e-6f);
+}
+
+TEST(Preprocess, BilateralKeepsPlanesAndEdgesAndInvalids) {
+  // A step from 1 m to 2 m: σ_d = 3 cm means the sides never mix; constant regions stay constant.
+  DepthImage d(12, 8, 1.0f);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 6; x < 12; ++x) d(x, y) = 2.0f;
+  d(3, 3) = 0.0f;
+  const Image<float> out = bilateral_filter_depth(DeviceImage<float>::from_host(d, Device::cpu()), 3, 4.5f, 0.03f).to_host();
+  EXPECT_FLOAT_EQ(out(5, 4), 1.0f);
+  EXPECT_FLOAT_EQ(out(6, 4), 2.0f);
+  EXPECT_EQ(out(3, 3), 0.0f);
+  EXPECT_THROW(bilateral_filter_depth(DeviceImage<float>::from_host(d, Device::cpu()), 0, 4.5f, 0.03f),
+               std::invalid_argument);
+}
+
+TEST(Preprocess, BilateralSmoothsNoiseTowardsTheMean) {
+  // Alternating ±5 mm around 1 m: the filtered centre is much closer to 1 m.
+  DepthImage d(9, 9);
+  for (int y = 0; y < 9; ++y)
+    for (int x = 0; x < 9; ++x) d(x, y) = 1.0f + ((x + y) % 2 ? 0.005f : -0.005f);
+  const Image<float> out = bilateral_filter_depth(DeviceImage<float>::from_host(d, Device::cpu()), 3, 4.5f, 0.03f).to_host();
+  EXPECT_LT(std::abs(out(4, 4) - 1.0f), 0.001f);
+}
+
+TEST(Preprocess, PyramidLevelsHaveHalvedIntrinsicsAndConsistentVertices) {
+  const Intrinsics K = test::test_intrinsics(161, 121);  // odd sizes round up
+  const auto box = test::render_box(K, test::look_at({0, 0, 0}, {2, 1, 0.5f}));
+  PreprocessParams p;
+  p.bilateral = false;
+  const FramePyramid pyr = build_pyramid(DeviceImage<float>::from_host(box.depth, Device::cpu()), K, p);
+  ASSERT_EQ(pyr.levels.size(), 3u);
+  EXPECT_EQ(pyr.levels[1].depth.width(), 81);
+  EXPECT_EQ(pyr.levels[2].depth.height(), 31);
+  EXPECT_FLOAT_EQ(pyr.levels[1].K.fx, K.fx / 2);
+  EXPECT_FLOAT_EQ(pyr.levels[1].K.cx, (K.cx + 0.5f) / 2 - 0.5f);
+  // A level-1 pixel's vertex lies on the same surface as the level-0 pixels it averages: its
+  // reprojection into level 0 lands between them.
+  const auto V1 = pyr.levels[1].maps.vertices.to_host();
+  const Eigen::Vector3f v = V1(20, 15);
+  ASSERT_GT(v.z(), 0.0f);
+  const Eigen::Vector2f uv = K.project(v);
+  EXPECT_NEAR(uv.x(), 40.5f, 0.05f);
+  EXPECT_NEAR(uv.y(), 30.5f, 0.05f);
+  EXPECT_THROW(build_pyramid(DeviceImage<float>::from_host(box.depth, Device::cpu()), test::test_intrinsics(160, 120), p),
+               std::invalid_argument);
+}
+
+std::vector<float> pyramid_depths(const Device& device) {
+  const Intrinsics K = test::test_intrinsics(96, 72);
+  auto box = test::render_box(K, test::look_at({0, 0, 0}, {2, 1, 0.5f}));
+  for (int i = 0; i < int(box.depth.size()); i += 7) box.depth[size_t(i)] += 0.004f * float(i % 5) - 0.008f;
+  const FramePyramid pyr = build_pyramid(DeviceImage<float>::from_host(box.depth, device), K, PreprocessParams{});
+  std::vector<float> out;
+  for (const PyramidLevel& l : pyr.levels) {
+    for (float d : l.depth.to_host().pixels()) out.push_back(d);
+    for (const auto& n : l.maps.normals.to_host().pixels()) out.push_back(n.x() + 2 * n.y() + 3 * n.z());
+  }
+  return out;
+}
+
+TEST(Preprocess, PyramidDeviceParity) { test::expect_device_parity<float>(pyramid_depths, 1e-5, 1e-5); }
+
+}  // namespace
+}  // namespace rrg
