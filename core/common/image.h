@@ -35,8 +35,11 @@ class Image {
 
   T* data() { return data_.data(); }
   const T* data() const { return data_.data(); }
-  std::span<T> pixels() { return data_; }
-  std::span<const T> pixels() const { return data_; }
+  // Views of the pixels. Not callable on a temporary image: `for (x : f().pixels())` would iterate
+  // over freed memory (a bug this caught twice, both found only by the CUDA parity runs).
+  std::span<T> pixels() & { return data_; }
+  std::span<const T> pixels() const& { return data_; }
+  void pixels() && = delete;
 
   template <class U>
   bool same_size(const Image<U>& o) const { return width_ == o.width() && height_ == o.height(); }

@@ -107,8 +107,10 @@ TEST(Icp, RejectsModelOnAnotherDeviceOrWrongSize) {
 std::vector<double> reduced_system(const Device& device) {
   const Scene s;
   const DeviceModel model = upload_model(s.model, device);
-  PreprocessParams pp;  // bilateral on: the filter and pyramid kernels run on the device too
-  const FramePyramid pyr = build_pyramid(DeviceImage<float>::from_host(s.frame.depth, device), s.K, pp);
+  // Bilateral off: its expf rounds differently on the GPU, and a few ulps there flip the pyramid's
+  // discontinuity test for some pixels at levels 1-2, which is not what this test is about (the
+  // filter's own parity is Preprocess.PyramidDeviceParity). The pyramid itself runs on the device.
+  const FramePyramid pyr = build_pyramid(DeviceImage<float>::from_host(s.frame.depth, device), s.K, no_filter());
   std::vector<double> out;
   for (const PyramidLevel& level : pyr.levels) {
     const kernel::IcpSystem sys = reduce_icp_system(level.maps, model.view(s.K, s.T_ref), s.T_ref, IcpParams{});

@@ -79,13 +79,18 @@ std::vector<float> pyramid_depths(const Device& device) {
   const FramePyramid pyr = build_pyramid(DeviceImage<float>::from_host(box.depth, device), K, PreprocessParams{});
   std::vector<float> out;
   for (const PyramidLevel& l : pyr.levels) {
-    for (float d : l.depth.to_host().pixels()) out.push_back(d);
-    for (const auto& n : l.maps.normals.to_host().pixels()) out.push_back(n.x() + 2 * n.y() + 3 * n.z());
+    const auto depth = l.depth.to_host();
+    const auto normals = l.maps.normals.to_host();
+    for (float d : depth.pixels()) out.push_back(d);
+    for (const auto& n : normals.pixels()) out.push_back(n.x() + 2 * n.y() + 3 * n.z());
   }
   return out;
 }
 
-TEST(Preprocess, PyramidDeviceParity) { test::expect_device_parity<float>(pyramid_depths, 1e-5, 1e-5); }
+// Tolerance: the bilateral weights use expf, which differs by a few ulps between the host and the
+// GPU; normals are cross products of differences of neighbouring vertices and amplify that to
+// ~3e-5 (seen on an H100). 1e-4 still catches any wrong pixel (those differ by O(1)).
+TEST(Preprocess, PyramidDeviceParity) { test::expect_device_parity<float>(pyramid_depths, 1e-4, 1e-4); }
 
 }  // namespace
 }  // namespace rrg
