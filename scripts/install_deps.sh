@@ -12,6 +12,12 @@ PACKAGES=(
   libgtest-dev libgmock-dev  # tests
   libbenchmark-dev       # bench/
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-features2d-dev  # image I/O, ORB
+  zlib1g-dev libzstd-dev     # SPZ (gzip), RVL+zstd depth
+  libdraco-dev               # Draco meshes
+  libyaml-cpp-dev            # session config files
+  libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc  # the service, remote semantic cue
+  libcpp-httplib-dev         # the service's Prometheus endpoint
+  libssl-dev                 # the service's tokens (RAND_bytes, SHA-256)
 )
 
 missing=()
