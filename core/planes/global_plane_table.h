@@ -26,6 +26,8 @@
 
 namespace rrg {
 
+struct PlaneStateIo;
+
 struct GlobalPlaneParams {
   float max_normal_angle_deg = 10.0f;  // geometric filter: normals within 10°
   float max_distance = 0.1f;           // ... and centroid-to-plane distance <= 0.1 m
@@ -100,6 +102,7 @@ class GlobalPlaneTable {
   size_t size() const { return planes_.size(); }  // instances ever created
 
  private:
+  friend struct PlaneStateIo;  // snapshots (plane_state_io.h)
   bool geometric_match(const Plane& a, const Eigen::Vector3f& centroid_b) const;
   void absorb(GlobalPlane& into, const LocalObservation& obs, int64_t frame);
   int create(const LocalObservation& obs, int64_t frame);

@@ -19,7 +19,7 @@ namespace rrg {
 struct PlaneEvalOptions {
   std::filesystem::path dataset;                    // synthetic layout folder
   std::vector<std::string> semantics = {"labels"};  // cues: none | labels | remote (first feeds fusion)
-  std::vector<std::string> prompts = paper_prompts();
+  std::vector<std::string> prompts = default_prompts();
   std::string remote_address;                       // for "remote"
   int period = 10;                                  // N_p
   size_t max_frames = 0;                            // 0 = all

@@ -9,6 +9,8 @@
 
 namespace rrg {
 
+struct PlaneStateIo;
+
 class PlaneMoments {
  public:
   void add(const Eigen::Vector3f& p) { add(double(p.x()), double(p.y()), double(p.z())); }
@@ -24,6 +26,7 @@ class PlaneMoments {
   Eigen::Matrix3d covariance() const;  // population covariance (divided by count)
 
  private:
+  friend struct PlaneStateIo;  // snapshots (plane_state_io.h)
   int64_t count_ = 0;
   double s_[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};  // Σx Σy Σz Σxx Σxy Σxz Σyy Σyz Σzz
 };

@@ -13,6 +13,8 @@
 
 namespace rrg {
 
+struct PlaneStateIo;
+
 struct Box2 {
   Eigen::Vector2f min{0, 0}, max{0, 0};  // inclusive metres in the plane basis
   bool empty = true;
@@ -54,6 +56,7 @@ class Footprint {
   const std::unordered_set<uint64_t>& cell_keys() const { return cells_; }
 
  private:
+  friend struct PlaneStateIo;  // snapshots (plane_state_io.h)
   PlaneBasis basis_;
   float cell_ = 0.05f;
   std::unordered_set<uint64_t> cells_;

@@ -57,29 +57,45 @@ IdentificationResult PlaneIdentifier::identify(const IdentificationFrame& frame,
   const std::vector<SemanticMask> masks = cue_->segment({frame.color, frame.labels, frame.index});
   for (const SemanticMask& m : masks)
     if (!m.mask.same_size(depth)) throw std::runtime_error("semantic cue " + cue_->name() + ": mask size differs from the frame");
-  // Per global plane: pixels, pixels above δ_v, and overlap with every mask.
+  // Per global plane: pixels, pixels above δ_v, and overlap (all pixels, pixels above δ_v) with
+  // every mask; per mask its pixel count.
   struct Stats {
     int64_t pixels = 0, high_variance = 0;
     double variance_sum = 0;
-    std::vector<int64_t> overlap;
+    std::vector<int64_t> overlap, overlap_high;
   };
   std::map<int, Stats> stats;
+  std::vector<int64_t> mask_pixels(masks.size(), 0);
   for (size_t i = 0; i < out.global_map.size(); ++i) {
+    for (size_t m = 0; m < masks.size(); ++m) mask_pixels[m] += masks[m].mask[i] ? 1 : 0;
     const int id = out.global_map[i];
     if (id == 0) continue;
     Stats& s = stats[id];
-    if (s.overlap.empty()) s.overlap.assign(masks.size(), 0);
+    if (s.overlap.empty()) s.overlap.assign(masks.size(), 0), s.overlap_high.assign(masks.size(), 0);
     ++s.pixels;
-    if (color_variance[i] > params_.variance_threshold) ++s.high_variance;
+    const bool high = color_variance[i] > params_.variance_threshold;
+    if (high) ++s.high_variance;
     s.variance_sum += color_variance[i];
-    for (size_t m = 0; m < masks.size(); ++m) s.overlap[m] += masks[m].mask[i] ? 1 : 0;
+    for (size_t m = 0; m < masks.size(); ++m)
+      if (masks[m].mask[i]) ++s.overlap[m], s.overlap_high[m] += high ? 1 : 0;
   }
+  // A plane's mask: a reflective mask that lies mostly on it (>= min_mask_overlap of the mask's
+  // pixels: a mirror or a screen on a wall is a part of the wall's plane, and the plane's largest
+  // mask is then the wall), else the mask of largest overlap covering >= min_mask_overlap of the
+  // plane (its label, for logs).
   std::map<int, int> plane_mask;  // global id -> associated mask index (-1 = none)
   for (auto& [id, s] : stats) {
     int best = -1;
     for (size_t m = 0; m < masks.size(); ++m)
-      if (s.overlap[m] > 0 && (best < 0 || s.overlap[m] > s.overlap[size_t(best)])) best = int(m);
-    if (best >= 0 && double(s.overlap[size_t(best)]) < params_.min_mask_overlap * double(s.pixels)) best = -1;
+      if (masks[m].reflective && s.overlap[m] > 0 &&
+          double(s.overlap[m]) >= params_.min_mask_overlap * double(mask_pixels[m]) &&
+          (best < 0 || s.overlap[m] > s.overlap[size_t(best)]))
+        best = int(m);
+    if (best < 0) {
+      for (size_t m = 0; m < masks.size(); ++m)
+        if (s.overlap[m] > 0 && (best < 0 || s.overlap[m] > s.overlap[size_t(best)])) best = int(m);
+      if (best >= 0 && double(s.overlap[size_t(best)]) < params_.min_mask_overlap * double(s.pixels)) best = -1;
+    }
     plane_mask[id] = best;
   }
   out.timings.semantic_ms = ms_since(t0);
@@ -95,8 +111,13 @@ IdentificationResult PlaneIdentifier::identify(const IdentificationFrame& frame,
     v.pixels = s.pixels;
     const int m = plane_mask[id];
     if (m >= 0) v.label = masks[size_t(m)].label;
-    v.candidate = cue_->every_plane_is_candidate() || (m >= 0 && masks[size_t(m)].reflective);
-    v.variance_fraction = s.pixels > 0 ? float(double(s.high_variance) / double(s.pixels)) : 0.0f;
+    const bool reflective_mask = m >= 0 && masks[size_t(m)].reflective;
+    v.candidate = cue_->every_plane_is_candidate() || reflective_mask;
+    // The variance check looks at the region claimed reflective: the plane's pixels inside its
+    // reflective mask when it has one, else all of its pixels.
+    const int64_t region = reflective_mask ? s.overlap[size_t(m)] : s.pixels;
+    const int64_t region_high = reflective_mask ? s.overlap_high[size_t(m)] : s.high_variance;
+    v.variance_fraction = region > 0 ? float(double(region_high) / double(region)) : 0.0f;
     v.variance_mean = s.pixels > 0 ? float(s.variance_sum / double(s.pixels)) : 0.0f;
     v.reflective_now = v.candidate && v.variance_fraction > params_.area_threshold;
     v.accepted = vote_.record(id, window, v.reflective_now);

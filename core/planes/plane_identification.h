@@ -22,6 +22,8 @@
 
 namespace rrg {
 
+struct PlaneStateIo;
+
 struct IdentificationParams {
   PlaneSegmentationParams segmentation;
   GlobalPlaneParams table;
@@ -82,6 +84,7 @@ class PlaneIdentifier {
   int64_t windows() const { return window_; }
 
  private:
+  friend struct PlaneStateIo;  // snapshots (plane_state_io.h)
   IdentificationParams params_;
   std::unique_ptr<SemanticCue> cue_;
   GlobalPlaneTable table_;

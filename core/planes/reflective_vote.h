@@ -11,6 +11,8 @@
 
 namespace rrg {
 
+struct PlaneStateIo;
+
 struct ReflectiveVoteParams {
   int windows = 5;        // history length
   int min_reflective = 4; // "more than three"
@@ -33,6 +35,7 @@ class ReflectiveVote {
   const std::set<int>& lookup_table() const { return lookup_; }  // L_ref
 
  private:
+  friend struct PlaneStateIo;  // snapshots (plane_state_io.h)
   ReflectiveVoteParams params_;
   std::map<int, std::deque<std::pair<int64_t, bool>>> history_;  // id -> (window, outcome), oldest first
   std::set<int> lookup_;

@@ -13,7 +13,7 @@ namespace rrg {
 
 struct RemoteSegmenterOptions {
   std::string address;                                  // "host:port" (insecure channel)
-  std::vector<std::string> prompts = paper_prompts();   // text prompts
+  std::vector<std::string> prompts = default_prompts();   // text prompts
   float box_threshold = 0.35f;                          // GroundingDINO defaults, passed through
   float text_threshold = 0.25f;
   double timeout_s = 30.0;                              // per call deadline

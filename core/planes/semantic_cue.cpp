@@ -12,6 +12,15 @@ const std::vector<std::string>& paper_prompts() {
   return prompts;
 }
 
+const std::vector<std::string>& default_prompts() {
+  static const std::vector<std::string> prompts = [] {
+    std::vector<std::string> p = paper_prompts();
+    p.push_back("mirror");
+    return p;
+  }();
+  return prompts;
+}
+
 namespace {
 
 std::string normalise(const std::string& s) {

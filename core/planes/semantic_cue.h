@@ -19,6 +19,9 @@ namespace rrg {
 
 // The paper's Grounded SAM2 prompts (supplement, "Grounded SAM2 Settings").
 const std::vector<std::string>& paper_prompts();
+// Our default: the paper's prompts plus "mirror" (the RIRD scenes have no mirrors; a mirror is the
+// most reflective surface an indoor capture meets).
+const std::vector<std::string>& default_prompts();
 
 struct SemanticMask {
   MaskImage mask;            // 0 / 1, the frame's size

@@ -120,6 +120,38 @@ TEST(PlaneIdentification, LowVarianceBelowAreaThresholdIsRejected) {
   EXPECT_TRUE(id.vote().lookup_table().empty());
 }
 
+// A mirror flush with a wall is part of the wall's plane, and the wall is the plane's largest mask.
+// The mirror's mask lies on that plane, so the plane is a candidate, the variance check looks at
+// the mirror's pixels (where the reflection varies), and the predicted mask is the mirror's.
+TEST(PlaneIdentification, MirrorOnAWallMakesTheWallPlaneACandidate) {
+  Scene s = make_scene();
+  for (int v = 0; v < 240; ++v)
+    for (int u = 100; u < 200; ++u)
+      if (s.labels(u, v) == 2 && v < 80) {
+        s.labels(u, v) = 3;                     // mirror: 100 x 80 px inside the wall
+        s.cvar(u, v) = (u % 4) ? 0.05f : 0.0f;  // 75% of it above δ_v
+      }
+  CategoryTable t = table();
+  t.names[3] = "mirror";
+  PlaneIdentifier id({}, make_label_semantics(t, default_prompts()));
+  IdentificationResult r = run(id, s, 3);
+  const PlaneVerdict& wall = verdict_for_label(r, s, 2);
+  EXPECT_EQ(verdict_for_label(r, s, 3).global_id, wall.global_id);  // one plane
+  EXPECT_EQ(wall.label, "mirror");
+  EXPECT_TRUE(wall.candidate);
+  EXPECT_NEAR(wall.variance_fraction, 0.75f, 0.02f);
+  EXPECT_TRUE(wall.reflective_now);
+  r = run(id, s, 1);
+  EXPECT_TRUE(verdict_for_label(r, s, 2).accepted);
+  for (size_t i = 0; i < s.labels.size(); ++i)  // floor (also accepted) and mirror, never the bare wall
+    ASSERT_EQ(r.reflection_mask[i], (s.labels[i] == 1 || s.labels[i] == 3) ? 1 : 0) << i;
+
+  // With the paper's prompts (no "mirror") the wall plane is not a candidate.
+  PlaneIdentifier paper({}, make_label_semantics(t, paper_prompts()));
+  r = run(paper, s, 4);
+  EXPECT_FALSE(verdict_for_label(r, s, 2).candidate);
+}
+
 TEST(PlaneIdentification, InputErrors) {
   const Scene s = make_scene();
   EXPECT_THROW(PlaneIdentifier({}, nullptr), std::invalid_argument);

@@ -1,0 +1,114 @@
+#include "core/planes/plane_state_io.h"
+
+#include <algorithm>
+#include <set>
+#include <stdexcept>
+
+namespace rrg {
+namespace {
+
+void put_v3(io::ByteWriter& w, const Eigen::Vector3f& v) { w.put(v.x()), w.put(v.y()), w.put(v.z()); }
+Eigen::Vector3f get_v3(io::ByteReader& r) {
+  const float x = r.get<float>(), y = r.get<float>(), z = r.get<float>();
+  return {x, y, z};
+}
+void put_box(io::ByteWriter& w, const Box2& b) {
+  w.put(b.min.x()), w.put(b.min.y()), w.put(b.max.x()), w.put(b.max.y()), w.put<uint8_t>(b.empty);
+}
+Box2 get_box(io::ByteReader& r) {
+  Box2 b;
+  b.min.x() = r.get<float>(), b.min.y() = r.get<float>(), b.max.x() = r.get<float>(), b.max.y() = r.get<float>();
+  b.empty = r.get<uint8_t>() != 0;
+  return b;
+}
+
+}  // namespace
+
+void PlaneStateIo::write(io::ByteWriter& w, const PlaneIdentifier& id) {
+  w.put<uint32_t>(1);  // format version
+  w.put<int64_t>(id.window_);
+  const GlobalPlaneTable& t = id.table_;
+  w.put<uint64_t>(t.planes_.size());
+  for (const GlobalPlane& g : t.planes_) {
+    w.put<int32_t>(g.id);
+    put_v3(w, g.plane.n);
+    w.put(g.plane.d);
+    put_v3(w, g.centroid);
+    w.put<int64_t>(g.moments.count_);
+    for (double s : g.moments.s_) w.put(s);
+    const Footprint& f = g.footprint;
+    put_v3(w, f.basis_.origin), put_v3(w, f.basis_.u), put_v3(w, f.basis_.v);
+    w.put(f.cell_);
+    put_box(w, f.box_);
+    std::vector<uint64_t> cells(f.cells_.begin(), f.cells_.end());
+    std::sort(cells.begin(), cells.end());
+    w.put_vector(cells);
+    w.put<int64_t>(g.first_seen), w.put<int64_t>(g.last_seen);
+    w.put<int32_t>(g.observations);
+    w.put<uint8_t>(g.alive);
+  }
+  std::vector<int32_t> parent(t.parent_.begin(), t.parent_.end());
+  w.put_vector(parent);
+  const ReflectiveVote& v = id.vote_;
+  w.put<uint64_t>(v.history_.size());
+  for (const auto& [plane, hist] : v.history_) {
+    w.put<int32_t>(plane);
+    w.put<uint64_t>(hist.size());
+    for (const auto& [window, outcome] : hist) w.put<int64_t>(window), w.put<uint8_t>(outcome);
+  }
+  std::vector<int32_t> lookup(v.lookup_.begin(), v.lookup_.end());
+  w.put_vector(lookup);
+}
+
+void PlaneStateIo::read(io::ByteReader& r, PlaneIdentifier& id) {
+  if (const auto version = r.get<uint32_t>(); version != 1)
+    throw std::runtime_error(r.what() + ": unsupported plane state version " + std::to_string(version));
+  id.window_ = r.get<int64_t>();
+  GlobalPlaneTable& t = id.table_;
+  const auto n = r.get<uint64_t>();
+  if (n > r.remaining()) throw std::runtime_error(r.what() + ": corrupt plane count");
+  t.planes_.clear();
+  for (uint64_t i = 0; i < n; ++i) {
+    GlobalPlane g;
+    g.id = r.get<int32_t>();
+    g.plane.n = get_v3(r);
+    g.plane.d = r.get<float>();
+    g.centroid = get_v3(r);
+    g.moments.count_ = r.get<int64_t>();
+    for (double& s : g.moments.s_) s = r.get<double>();
+    Footprint& f = g.footprint;
+    f.basis_.origin = get_v3(r), f.basis_.u = get_v3(r), f.basis_.v = get_v3(r);
+    f.cell_ = r.get<float>();
+    f.box_ = get_box(r);
+    for (uint64_t c : r.get_vector<uint64_t>()) f.cells_.insert(c);
+    g.first_seen = r.get<int64_t>(), g.last_seen = r.get<int64_t>();
+    g.observations = r.get<int32_t>();
+    g.alive = r.get<uint8_t>() != 0;
+    if (g.id != int(i) + 1) throw std::runtime_error(r.what() + ": plane ids are not 1..n");
+    t.planes_.push_back(std::move(g));
+  }
+  const auto parent = r.get_vector<int32_t>();
+  if (parent.size() != t.planes_.size() + 1) throw std::runtime_error(r.what() + ": union-find table size mismatch");
+  for (int32_t p : parent)
+    if (p < 0 || size_t(p) > t.planes_.size()) throw std::runtime_error(r.what() + ": union-find entry out of range");
+  t.parent_.assign(parent.begin(), parent.end());
+  ReflectiveVote& v = id.vote_;
+  v.history_.clear();
+  const auto hn = r.get<uint64_t>();
+  if (hn > r.remaining()) throw std::runtime_error(r.what() + ": corrupt vote history");
+  for (uint64_t i = 0; i < hn; ++i) {
+    const int plane = r.get<int32_t>();
+    const auto len = r.get<uint64_t>();
+    if (len > r.remaining()) throw std::runtime_error(r.what() + ": corrupt vote history");
+    auto& hist = v.history_[plane];
+    for (uint64_t j = 0; j < len; ++j) {
+      const auto window = r.get<int64_t>();
+      const bool outcome = r.get<uint8_t>() != 0;
+      hist.emplace_back(window, outcome);
+    }
+  }
+  const auto lookup = r.get_vector<int32_t>();
+  v.lookup_ = std::set<int>(lookup.begin(), lookup.end());
+}
+
+}  // namespace rrg
