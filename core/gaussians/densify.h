@@ -1,0 +1,82 @@
+#pragma once
+// Gaussian densification (paper §4.2.1, supplement): candidate pixels of one posed frame, a sampled
+// subset of them, and new Gaussians initialised from the samples as GPS-SLAM does. Host code over
+// host images (a few image-sized passes once per mapping step; the optimisation dominates).
+//
+// Base G_b:  |C_gt − C| > δ_b and W_b < δ_w,b, and observed depth D_gt > 0. The position is the
+//            back-projected observed depth.
+// Reflection G_r: R = 1, |C_gt − C| > δ_r, C_var > δ_v, W_r < δ_w,r, and I(u) a plane of L_ref.
+//            Ten Gaussians per sample, evenly spaced 2–8 m past the ray–plane intersection along
+//            the viewing ray (virtual space), with the plane id ℓ = I(u).
+// |C_gt − C| is the mean absolute difference over the three channels.
+//
+// Initialisation: scale s = sqrt(mean of the squared distances to the 3 nearest new points of the
+// same call), clamped to [min_init_scale, max_init_scale] (neighbours farther than the cap count as
+// the cap). Base: 1 cm (GPS-SLAM). Reflection: 10 cm — reflection Gaussians sit 2–8 m past the
+// plane, where 1 cm is a tenth of a pixel at 640 px and the nearest new points on neighbouring rays
+// are centimetres apart; the cap keeps them under the reflection prune maximum (0.2 m); the Gaussian is flattened along the surface normal (base: normal of the observed depth;
+// reflection: plane normal) to flatten · s; opacity 0.5; SH DC from the colour, higher bands 0.
+// Colour = C_gt(u) for both sets (the paper); reflection_residual_color uses max(C_gt − C_b, 0)
+// instead (C = C_b + R C_r is additive, so the pixel colour counts the base twice at first).
+// min_init_scale keeps a new Gaussian above the prune threshold of its set (else it would be
+// removed in the step that created it).
+//
+// Sampling: a candidate is kept when hash(seed, pixel) < sample_ratio — deterministic, independent
+// of threads and order.
+#include "core/common/camera.h"
+#include "core/common/image.h"
+#include "core/gaussians/gaussian_set.h"
+#include "core/gaussians/reflective_plane.h"
+
+#include <Eigen/Geometry>
+
+#include <cstdint>
+#include <span>
+
+namespace rrg {
+
+struct DensifyParams {
+  float base_error = 0.05f;          // δ_b
+  float base_weight = 3.0f;          // δ_w,b
+  float reflection_error = 0.05f;    // δ_r
+  float variance = 0.01f;            // δ_v
+  float reflection_weight = 0.5f;    // δ_w,r
+  float sample_ratio = 0.5f;         // fraction of candidate pixels that get Gaussians
+  int reflection_samples = 10;       // Gaussians per reflection sample along the ray
+  float reflection_near = 2.0f;      // metres past the ray–plane intersection
+  float reflection_far = 8.0f;
+  float max_init_scale = 0.01f;      // 1 cm cap (GPS-SLAM), base Gaussians
+  float reflection_max_init_scale = 0.1f;  // reflection cap: half the reflection prune max (0.2)
+  float base_min_init_scale = 0.0045f;        // 1.5 x the base prune min scale (0.003)
+  float reflection_min_init_scale = 0.0075f;  // 1.5 x the reflection prune min scale (0.005)
+  float flatten = 0.1f;              // normal-axis scale / tangential scale
+  float init_opacity = 0.5f;
+  bool reflection_residual_color = false;  // reflection colour max(C_gt − C_b, 0) instead of C_gt
+  void validate() const;             // throws std::invalid_argument naming the bad field
+};
+
+// What densification reads of one frame (host images, all K's size; null where not needed).
+struct DensifyView {
+  Intrinsics K;
+  Eigen::Isometry3f T_wc = Eigen::Isometry3f::Identity();
+  const ColorImage* C_gt = nullptr;     // input colour
+  const DepthImage* D_gt = nullptr;     // input depth (base)
+  const ColorImage* C = nullptr;        // rendered C = C_b + R C_r
+  const ColorImage* C_b = nullptr;      // rendered base colour (reflection colour init)
+  const Image<float>* W_b = nullptr;    // W_g, base Gaussian weight
+  const Image<float>* W_r = nullptr;    // reflection Gaussian weight
+  const MaskImage* R = nullptr;         // reflection mask
+  const Image<float>* C_var = nullptr;  // TSDF colour variance
+  const Image<int32_t>* I = nullptr;    // plane ids
+};
+
+GaussianHost densify_base(const DensifyView& view, const DensifyParams& params, int sh_degree, uint64_t seed);
+GaussianHost densify_reflection(const DensifyView& view, std::span<const ReflectivePlane> planes,
+                                const DensifyParams& params, int sh_degree, uint64_t seed);
+
+// The shared initialisation: points (world), unit normals along which to flatten, colours, plane ids.
+GaussianHost init_gaussians(std::span<const Eigen::Vector3f> points, std::span<const Eigen::Vector3f> normals,
+                            std::span<const Color> colors, std::span<const int32_t> plane_ids,
+                            const DensifyParams& params, float min_init_scale, float max_init_scale, int sh_degree);
+
+}  // namespace rrg

@@ -1,0 +1,43 @@
+#pragma once
+// The mapping losses of paper §4.2.2 on the device the images live on (CPU or CUDA, one source):
+//   L = (1 − λ) L1(C, C_gt) + λ (1 − SSIM(C, C_gt))    λ = 0.2
+//     + λ_d · L1(D_b, D_gt) over pixels with D_gt > 0   λ_d = 0.2
+//     + λ_g · ‖Sobel(C_r)‖₁                            λ_g = 0.05
+// Every term returns its (unweighted) value and, when given a gradient image, ADDS
+// weight · ∂term/∂input to it, so the caller builds the renderer's upstream images term by term.
+// Means are over pixels and channels (SSIM: 3DGS's window and constants, core/eval/image_metrics.h).
+#include "core/common/buffer.h"
+
+namespace rrg {
+
+struct LossWeights {
+  float lambda_ssim = 0.2f;    // λ of L_color
+  float lambda_depth = 0.2f;   // λ_d
+  float lambda_sobel = 0.05f;  // λ_g
+  void validate() const;       // throws std::invalid_argument naming the bad weight
+};
+
+struct LossValues {
+  double l1 = 0, ssim = 0, depth_l1 = 0, sobel = 0;
+  double total = 0;  // (1 − λ) l1 + λ (1 − ssim) + λ_d depth_l1 + λ_g sobel
+};
+
+// mean |x − y|; v_x += weight ∂/∂x.
+float l1_loss(const DeviceImage<Color>& x, const DeviceImage<Color>& y, DeviceImage<Color>* v_x, float weight);
+// mean SSIM(x, y) (y is the reference); v_x += weight ∂/∂x. scratch is resized as needed.
+float ssim(const DeviceImage<Color>& x, const DeviceImage<Color>& y, DeviceImage<Color>* v_x, float weight,
+           Buffer<float>& scratch);
+// mean |d − d_gt| over d_gt > 0 (0 when none); v_d += weight ∂/∂d.
+float depth_l1_loss(const DeviceImage<float>& d, const DeviceImage<float>& d_gt, DeviceImage<float>* v_d,
+                    float weight);
+// mean (|Gx| + |Gy|) of the Sobel responses over interior pixels; v_x += weight ∂/∂x.
+float sobel_l1_loss(const DeviceImage<Color>& x, DeviceImage<Color>* v_x, float weight);
+
+// The whole mapping loss. Overwrites v_C, v_D_b (and v_C_r when C_r is given and λ_g > 0; else it
+// is left empty) with ∂L/∂C, ∂L/∂D_b, ∂L/∂C_r, allocated on the images' device.
+LossValues mapping_loss(const DeviceImage<Color>& C, const DeviceImage<Color>& C_gt, const DeviceImage<float>& D_b,
+                        const DeviceImage<float>& D_gt, const DeviceImage<Color>* C_r, const LossWeights& w,
+                        DeviceImage<Color>& v_C, DeviceImage<float>& v_D_b, DeviceImage<Color>& v_C_r,
+                        Buffer<float>& ssim_scratch);
+
+}  // namespace rrg

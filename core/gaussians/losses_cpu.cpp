@@ -1,0 +1,33 @@
+#include "core/common/parallel_for.h"
+#include "core/gaussians/losses_impl.h"
+
+namespace rrg::kernel {
+
+template <class T>
+T l1_loss_cpu(Span<const T> x, Span<const T> y, Span<T> v_x, T weight) {
+  return l1_loss(CpuBackend{}, x, y, v_x, weight);
+}
+template <class T>
+T depth_l1_loss_cpu(Span<const T> d, Span<const T> d_gt, Span<T> v_d, T weight) {
+  return depth_l1_loss(CpuBackend{}, d, d_gt, v_d, weight);
+}
+template <class T>
+T ssim_cpu(int w, int h, Span<const T> x, Span<const T> y, Span<T> v_x, T weight, SsimWindow<T> win,
+           Span<T> scratch) {
+  return ssim(CpuBackend{}, w, h, x, y, v_x, weight, win, scratch);
+}
+template <class T>
+T sobel_l1_loss_cpu(int w, int h, Span<const T> x, Span<T> v_x, T weight) {
+  return sobel_l1_loss(CpuBackend{}, w, h, x, v_x, weight);
+}
+
+#define RRG_LOSSES_INSTANTIATE(T)                                                                  \
+  template T l1_loss_cpu<T>(Span<const T>, Span<const T>, Span<T>, T);                             \
+  template T depth_l1_loss_cpu<T>(Span<const T>, Span<const T>, Span<T>, T);                       \
+  template T ssim_cpu<T>(int, int, Span<const T>, Span<const T>, Span<T>, T, SsimWindow<T>, Span<T>); \
+  template T sobel_l1_loss_cpu<T>(int, int, Span<const T>, Span<T>, T);
+RRG_LOSSES_INSTANTIATE(float)
+RRG_LOSSES_INSTANTIATE(double)
+#undef RRG_LOSSES_INSTANTIATE
+
+}  // namespace rrg::kernel

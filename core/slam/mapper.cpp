@@ -1,0 +1,346 @@
+#include "core/slam/mapper.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+#include <random>
+#include <stdexcept>
+#include <string>
+
+namespace rrg {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+constexpr float kDepthUnits = 5000.0f;  // stored depth steps per metre
+
+uint64_t mix(uint64_t x) {
+  x += 0x9E3779B97F4A7C15ull;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+  return x ^ (x >> 31);
+}
+
+template <class T>
+DeviceImage<T> clone(const DeviceImage<T>& im) {
+  DeviceImage<T> out(im.width(), im.height(), im.device());
+  mem::copy(out.buffer().data(), im.device(), im.buffer().data(), im.device(), im.buffer().size() * sizeof(T));
+  return out;
+}
+
+DeviceImage<float> mask_to_float(const DeviceImage<uint8_t>& m, const Device& device) {
+  const Image<uint8_t> h = m.to_host();
+  Image<float> f(h.width(), h.height());
+  for (size_t i = 0; i < h.size(); ++i) f[i] = h[i] ? 1.0f : 0.0f;
+  return DeviceImage<float>::from_host(f, device);
+}
+
+// Pass-1 results as the renderer takes them (R = R_raw > 0.5 as 0 / 1).
+RaycastInputs to_inputs(RaycastResult&& r, const Device& device) {
+  RaycastInputs in;
+  in.R = mask_to_float(r.reflection_mask, device);
+  in.C_t = std::move(r.colors);
+  in.D_t = std::move(r.depth);
+  in.I = std::move(r.plane_ids);
+  return in;
+}
+
+RaycastInputs copy_inputs(const RaycastResult& r, const Device& device) {
+  RaycastInputs in;
+  in.R = mask_to_float(r.reflection_mask, device);
+  in.C_t = clone(r.colors);
+  in.D_t = clone(r.depth);
+  in.I = clone(r.plane_ids);
+  return in;
+}
+
+void append_to(GaussianSet& set, GaussianAdam& adam, const GaussianHost& batch) {
+  if (batch.size() == 0) return;
+  set.append(batch);
+  adam.grow(set.size());
+}
+
+int64_t prune_set(GaussianSet& set, GaussianAdam& adam, const PruneParams& p) {
+  const std::vector<uint8_t> keep = prune_mask(set, p);
+  const size_t before = set.size();
+  if (std::all_of(keep.begin(), keep.end(), [](uint8_t k) { return k != 0; })) return 0;
+  const Compaction c = set.prune(keep);
+  adam.compact(c);
+  return int64_t(before - set.size());
+}
+
+}  // namespace
+
+// Compact host copy of a frame: 8-bit colour, depth in 1/5000 m.
+struct GaussianMapper::StoredFrame {
+  int64_t index = 0;
+  Eigen::Isometry3f T_wc = Eigen::Isometry3f::Identity();
+  int width = 0, height = 0;
+  std::vector<uint8_t> rgb;      // [H, W, 3]
+  std::vector<uint16_t> depth;   // [H, W]
+
+  ColorImage color() const {
+    ColorImage c(width, height);
+    for (size_t i = 0; i < c.size(); ++i)
+      c[i] = Color(rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]) / 255.0f;
+    return c;
+  }
+  DepthImage depth_m() const {
+    DepthImage d(width, height);
+    for (size_t i = 0; i < d.size(); ++i) d[i] = float(depth[i]) / kDepthUnits;
+    return d;
+  }
+};
+
+// A selected frame for one step: ground truth on the host and the device, pass 1 at its pose.
+struct GaussianMapper::StepFrame {
+  const StoredFrame* frame = nullptr;
+  bool local = false;
+  ColorImage C_gt_host;
+  DepthImage D_gt_host;
+  DeviceImage<Color> C_gt;
+  DeviceImage<float> D_gt;
+  RaycastInputs rc;
+  Image<float> C_var;  // host, for reflection densification
+  Image<uint8_t> R;
+};
+
+GaussianMapper::GaussianMapper(const MapperParams& params, const Intrinsics& K, const Device& device)
+    : params_(params),
+      K_(K),
+      device_(device),
+      base_(params.sh_degree, device),
+      refl_(params.sh_degree, device),
+      adam_base_(params.adam_base, params.sh_degree, device),
+      adam_refl_(params.adam_reflection, params.sh_degree, device),
+      renderer_(device, params.render),
+      query_renderer_(device, params.render) {
+  params_.validate();
+  if (!K.valid()) throw std::invalid_argument("GaussianMapper: invalid intrinsics " + K.to_string());
+  publish();
+}
+
+void GaussianMapper::add_frame(MappingFrame frame, bool keyframe) {
+  if (frame.color.width() != K_.width || frame.color.height() != K_.height || !frame.depth.same_size(frame.color))
+    throw std::invalid_argument("GaussianMapper::add_frame: frame " + std::to_string(frame.index) + " is " +
+                                std::to_string(frame.color.width()) + "x" + std::to_string(frame.color.height()) +
+                                " (depth " + std::to_string(frame.depth.width()) + "x" +
+                                std::to_string(frame.depth.height()) + "), the mapper expects " + K_.to_string());
+  auto s = std::make_shared<StoredFrame>();
+  s->index = frame.index;
+  s->T_wc = frame.T_wc;
+  s->width = K_.width;
+  s->height = K_.height;
+  s->rgb.resize(frame.color.size() * 3);
+  s->depth.resize(frame.depth.size());
+  for (size_t i = 0; i < frame.color.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      s->rgb[3 * i + c] = uint8_t(std::lround(std::clamp(frame.color[i][c], 0.0f, 1.0f) * 255.0f));
+  for (size_t i = 0; i < frame.depth.size(); ++i) {
+    const float d = frame.depth[i];
+    s->depth[i] = (d > 0 && std::isfinite(d)) ? uint16_t(std::min(std::lround(d * kDepthUnits), 65535l)) : 0;
+  }
+  std::lock_guard lock(frames_mutex_);
+  recent_.push_back(s);
+  if (keyframe) keyframes_.push_back(s);
+}
+
+size_t GaussianMapper::queued_frames() const {
+  std::lock_guard lock(frames_mutex_);
+  return recent_.size();
+}
+
+size_t GaussianMapper::keyframes() const {
+  std::lock_guard lock(frames_mutex_);
+  return keyframes_.size();
+}
+
+// N_local evenly spaced over the recent frames (the newest included), then N_global distinct random
+// keyframes not already chosen. The recent frames are consumed.
+std::vector<std::shared_ptr<const GaussianMapper::StoredFrame>> GaussianMapper::select_frames(uint64_t seed) {
+  std::lock_guard lock(frames_mutex_);
+  std::vector<std::shared_ptr<const StoredFrame>> out;
+  const size_t n = recent_.size(), L = size_t(params_.n_local);
+  if (n > 0 && L > 0) {
+    if (n <= L) {
+      out.assign(recent_.begin(), recent_.end());
+    } else {
+      for (size_t j = 0; j < L; ++j) out.push_back(recent_[(j + 1) * n / L - 1]);
+    }
+  }
+  recent_.clear();
+  std::vector<size_t> pool;
+  for (size_t i = 0; i < keyframes_.size(); ++i)
+    if (std::none_of(out.begin(), out.end(), [&](const auto& f) { return f.get() == keyframes_[i].get(); }))
+      pool.push_back(i);
+  std::mt19937_64 rng(seed);
+  for (int g = 0; g < params_.n_global && !pool.empty(); ++g) {
+    const size_t k = size_t(rng() % pool.size());
+    out.push_back(keyframes_[pool[k]]);
+    pool.erase(pool.begin() + std::ptrdiff_t(k));
+  }
+  return out;
+}
+
+MappingStats GaussianMapper::step(const MappingContext& ctx) {
+  std::lock_guard step_lock(step_mutex_);
+  const auto t_start = Clock::now();
+  MappingStats st;
+  if (!ctx.raycast) throw std::invalid_argument("GaussianMapper::step: the context has no raycast function");
+  int64_t newest = -1;
+  {
+    std::lock_guard lock(frames_mutex_);
+    if (!recent_.empty()) newest = recent_.back()->index;
+  }
+  const uint64_t seed = mix(params_.seed ^ mix(steps_ + 1) ^ mix(uint64_t(newest) * 0x100000001b3ull));
+  const size_t n_local = [&] {
+    std::lock_guard lock(frames_mutex_);
+    return std::min(recent_.size(), size_t(params_.n_local));
+  }();
+  const auto selected = select_frames(seed);
+  ++steps_;
+  if (selected.empty()) {
+    publish();
+    st.ms_total = ms_since(t_start);
+    return st;
+  }
+
+  // 1. pass 1 and ground truth of every selected frame
+  auto t0 = Clock::now();
+  std::vector<StepFrame> frames(selected.size());
+  for (size_t i = 0; i < selected.size(); ++i) {
+    StepFrame& f = frames[i];
+    f.frame = selected[i].get();
+    f.local = i < n_local;
+    f.C_gt_host = f.frame->color();
+    f.D_gt_host = f.frame->depth_m();
+    f.C_gt = DeviceImage<Color>::from_host(f.C_gt_host, device_);
+    f.D_gt = DeviceImage<float>::from_host(f.D_gt_host, device_);
+    RaycastResult r = ctx.raycast(K_, f.frame->T_wc);
+    if (r.depth.width() != K_.width || r.depth.height() != K_.height)
+      throw std::runtime_error("GaussianMapper::step: the raycast returned images of the wrong size");
+    if (f.local) {
+      f.C_var = r.color_variance.to_host();
+      f.R = r.reflection_mask.to_host();
+    }
+    f.rc = to_inputs(std::move(r), device_);
+  }
+  st.ms_raycast = ms_since(t0);
+
+  // 2. densification on the local frames
+  t0 = Clock::now();
+  const bool reflections = params_.reflections && !ctx.planes.empty();
+  RenderOutputs out;
+  for (StepFrame& f : frames) {
+    if (!f.local) continue;
+    renderer_.render({K_, f.frame->T_wc}, base_, refl_, f.rc, out);
+    const ColorImage C = out.C.to_host(), C_b = out.C_b.to_host();
+    const Image<float> W_b = out.W_g.to_host(), W_r = out.W_r.to_host();
+    const Image<int32_t> I = f.rc.I.to_host();
+    DensifyView v;
+    v.K = K_;
+    v.T_wc = f.frame->T_wc;
+    v.C_gt = &f.C_gt_host;
+    v.D_gt = &f.D_gt_host;
+    v.C = &C;
+    v.C_b = &C_b;
+    v.W_b = &W_b;
+    v.W_r = &W_r;
+    v.R = &f.R;
+    v.C_var = &f.C_var;
+    v.I = &I;
+    const uint64_t fseed = mix(seed ^ mix(uint64_t(f.frame->index)));
+    const GaussianHost nb = densify_base(v, params_.densify, params_.sh_degree, fseed);
+    append_to(base_, adam_base_, nb);
+    st.base_added += int64_t(nb.size());
+    if (reflections) {
+      const GaussianHost nr = densify_reflection(v, ctx.planes, params_.densify, params_.sh_degree, mix(fseed));
+      append_to(refl_, adam_refl_, nr);
+      st.reflection_added += int64_t(nr.size());
+    }
+  }
+  st.ms_densify = ms_since(t0);
+
+  // 3. optimisation: a seeded shuffle of the selected frames, cycled
+  t0 = Clock::now();
+  std::vector<size_t> order(frames.size());
+  std::iota(order.begin(), order.end(), size_t(0));
+  std::mt19937_64 rng(mix(seed));
+  for (size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[size_t(rng() % i)]);
+  const LossWeights lw = params_.loss_weights();
+  RenderUpstream up;
+  double loss_sum = 0;
+  for (int it = 0; it < params_.iterations; ++it) {
+    StepFrame& f = frames[order[size_t(it) % order.size()]];
+    renderer_.render({K_, f.frame->T_wc}, base_, refl_, f.rc, out);
+    const bool with_refl = reflections && refl_.size() > 0;
+    const LossValues L = mapping_loss(out.C, f.C_gt, out.D_b, f.D_gt, with_refl ? &out.C_r : nullptr, lw, up.v_C,
+                                      up.v_D_b, up.v_C_r, ssim_scratch_);
+    loss_sum += L.total;
+    renderer_.backward(up, v_base_, v_refl_);
+    adam_base_.step(base_, v_base_);
+    if (refl_.size() > 0) adam_refl_.step(refl_, v_refl_);
+  }
+  st.iterations = params_.iterations;
+  st.frames = int(frames.size());
+  st.loss = params_.iterations > 0 ? loss_sum / params_.iterations : 0.0;
+  st.ms_optimise = ms_since(t0);
+
+  // 4. pruning
+  t0 = Clock::now();
+  st.base_pruned = prune_set(base_, adam_base_, params_.prune_base);
+  st.reflection_pruned = prune_set(refl_, adam_refl_, params_.prune_reflection);
+  st.ms_prune = ms_since(t0);
+  st.base_size = int64_t(base_.size());
+  st.reflection_size = int64_t(refl_.size());
+
+  publish();
+  st.ms_total = ms_since(t_start);
+  spdlog::debug("mapping step {}: {} frames, +{} / -{} base ({}), +{} / -{} reflection ({}), loss {:.4f}, {:.1f} ms",
+                steps_, st.frames, st.base_added, st.base_pruned, st.base_size, st.reflection_added,
+                st.reflection_pruned, st.reflection_size, st.loss, st.ms_total);
+  return st;
+}
+
+void GaussianMapper::publish() {
+  auto snap = std::make_shared<MapSnapshot>(MapSnapshot{GaussianSet::from_host(base_.to_host(), device_),
+                                                        GaussianSet::from_host(refl_.to_host(), device_), 0});
+  std::lock_guard lock(snapshot_mutex_);
+  snap->version = ++version_;
+  snapshot_ = std::move(snap);
+}
+
+std::shared_ptr<const MapSnapshot> GaussianMapper::snapshot() const {
+  std::lock_guard lock(snapshot_mutex_);
+  return snapshot_;
+}
+
+void GaussianMapper::render(const RenderCamera& cam, const RaycastResult& raycast, RenderOutputs& out) const {
+  const auto snap = snapshot();
+  const RaycastInputs in = copy_inputs(raycast, device_);
+  std::lock_guard lock(render_mutex_);
+  query_renderer_.render(cam, snap->base, snap->reflection, in, out);
+}
+
+GaussianHost GaussianMapper::base_host() const { return snapshot()->base.to_host(); }
+GaussianHost GaussianMapper::reflection_host() const { return snapshot()->reflection.to_host(); }
+
+void GaussianMapper::load(const GaussianHost& base, const GaussianHost& reflection) {
+  std::lock_guard step_lock(step_mutex_);
+  base_ = GaussianSet::from_host(base, device_);
+  refl_ = GaussianSet::from_host(reflection, device_);
+  adam_base_ = GaussianAdam(params_.adam_base, base.sh_degree, device_);
+  adam_refl_ = GaussianAdam(params_.adam_reflection, reflection.sh_degree, device_);
+  adam_base_.reset(base_.size());
+  adam_refl_.reset(refl_.size());
+  publish();
+}
+
+}  // namespace rrg

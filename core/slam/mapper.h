@@ -1,0 +1,147 @@
+#pragma once
+// The online Gaussian mapping step (paper §4.2, DESIGN.md §1): every N_o frames the session hands
+// the fused frames to the mapper and calls step():
+//   1. frames: N_local = 2 evenly sampled from the frames added since the last step (the newest
+//      included) + N_global = 7 random keyframes (seeded: params.seed, step count, newest index);
+//   2. densify base and reflection Gaussians on the N_local frames (core/gaussians/densify.h);
+//   3. `iterations` = 30 Adam iterations, each on one of the selected frames (a seeded shuffle of
+//      the set, cycled): render C, D_b, C_r → L = (1−λ)L1 + λ(1−SSIM) + λ_d L1(D_b) + λ_g‖Sobel C_r‖₁
+//      → backward → Adam on the visible Gaussians of each set;
+//   4. prune both sets (core/gaussians/prune.h), Adam state compacted alongside;
+//   5. publish an immutable MapSnapshot for render() / exports.
+// Frames: add_frame() takes every fused frame (the session may also pass every N_o-th only); the
+// frames since the last step are dropped after it, keyframes are kept for N_global sampling. Host
+// copies are compact: 8-bit colour and depth in 1/5000 m steps (uint16, up to 13.1 m).
+// The mapper never touches the TSDF: MappingContext::raycast gives pass 1 at any camera.
+// Deterministic on the CPU: the same frames, planes and params give the same map.
+#include "core/common/camera.h"
+#include "core/common/image.h"
+#include "core/gaussians/adam.h"
+#include "core/gaussians/densify.h"
+#include "core/gaussians/gaussian_grads.h"
+#include "core/gaussians/gaussian_set.h"
+#include "core/gaussians/losses.h"
+#include "core/gaussians/prune.h"
+#include "core/gaussians/reflective_plane.h"
+#include "core/render/render_types.h"
+#include "core/render/renderer.h"
+#include "core/tsdf/tsdf_raycast.h"
+
+#include <Eigen/Geometry>
+
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+namespace rrg {
+
+struct ConfigField;  // core/slam/session_config.h
+
+struct MapperParams {            // paper defaults (DESIGN.md §5); validate() throws invalid_argument
+  int iterations = 30;           // per mapping step
+  int n_local = 2;               // N_local frames since the last step
+  int n_global = 7;              // N_global random keyframes
+  float lambda_ssim = 0.2f;      // λ of L_color
+  float lambda_depth = 0.2f;     // λ_d
+  float lambda_sobel = 0.05f;    // λ_g
+  int sh_degree = 3;             // SH degree of new Gaussians (the supplement's lr_SHrest implies > 0)
+  uint64_t seed = 0;             // keyframe sampling, frame order, densification sampling
+  bool reflections = true;       // false = base only (the --no-reflections ablation)
+  DensifyParams densify;         // δ_b, δ_w,b, δ_r, δ_v, δ_w,r, sampling ratio, initialisation
+  PruneParams prune_base = PruneParams::base();              // 0.005 / 0.003 / 0.1
+  PruneParams prune_reflection = PruneParams::reflection();  // 0.005 / 0.005 / 0.2
+  AdamParams adam_base{AdamLearningRates::base()};
+  AdamParams adam_reflection{AdamLearningRates::reflection()};
+  RenderParams render;           // renderer settings (ε = TSDF truncation, ...)
+  void validate() const;
+  LossWeights loss_weights() const { return {lambda_ssim, lambda_depth, lambda_sobel}; }
+};
+
+// The named fields of MapperParams for configuration files and --set (names without "mapping.").
+std::vector<ConfigField> mapper_config_fields(MapperParams& p);
+
+struct MappingFrame {            // one posed RGB-D frame (host)
+  int64_t index = 0;
+  Eigen::Isometry3f T_wc = Eigen::Isometry3f::Identity();
+  ColorImage color;              // C_gt
+  DepthImage depth;              // D_gt, metres, 0 = invalid
+};
+
+struct MappingContext {
+  // Pass 1 at a camera (the session serialises it against fusion).
+  std::function<RaycastResult(const Intrinsics&, const Eigen::Isometry3f&)> raycast;
+  std::vector<ReflectivePlane> planes;  // accepted reflective planes (L_ref) with their equations
+};
+
+struct MappingStats {
+  int iterations = 0;
+  int frames = 0;                  // frames optimised on (local + global)
+  int64_t base_added = 0, reflection_added = 0, base_pruned = 0, reflection_pruned = 0;
+  int64_t base_size = 0, reflection_size = 0;  // after the step
+  double loss = 0;                 // mean total loss over the iterations
+  double ms_raycast = 0, ms_densify = 0, ms_optimise = 0, ms_prune = 0, ms_total = 0;
+};
+
+struct MapSnapshot {             // immutable once published
+  GaussianSet base, reflection;
+  uint64_t version = 0;            // number of published steps / loads
+};
+
+class GaussianMapper {
+ public:
+  GaussianMapper(const MapperParams& params, const Intrinsics& K, const Device& device);
+
+  // Queues a fused frame; keyframes are also kept for N_global sampling. Throws
+  // std::invalid_argument for a frame whose size differs from K.
+  void add_frame(MappingFrame frame, bool keyframe);
+  // One mapping step (densify → iterations → prune), then publishes a snapshot. Without any frame
+  // (queued or keyframe) it only republishes. Not re-entrant (one step at a time).
+  MappingStats step(const MappingContext& ctx);
+  // The latest published snapshot (never null). Thread-safe.
+  std::shared_ptr<const MapSnapshot> snapshot() const;
+  // Renders passes 2 and 3 of the latest snapshot at cam over a raycast at the same camera.
+  // Thread-safe with step().
+  void render(const RenderCamera& cam, const RaycastResult& raycast, RenderOutputs& out) const;
+  GaussianHost base_host() const;
+  GaussianHost reflection_host() const;
+  // Replaces both sets (session load); optimiser state restarts. Publishes a snapshot.
+  void load(const GaussianHost& base, const GaussianHost& reflection);
+
+  const MapperParams& params() const { return params_; }
+  const Intrinsics& intrinsics() const { return K_; }
+  size_t queued_frames() const;
+  size_t keyframes() const;
+
+ private:
+  struct StoredFrame;            // compact host copy (mapper.cpp)
+  struct StepFrame;              // a selected frame with its images on the device for one step
+  std::vector<std::shared_ptr<const StoredFrame>> select_frames(uint64_t seed);
+  void publish();
+
+  MapperParams params_;
+  Intrinsics K_;
+  Device device_;
+  GaussianSet base_, refl_;
+  GaussianAdam adam_base_, adam_refl_;
+  GaussianGrads v_base_, v_refl_;
+  Renderer renderer_;
+  Buffer<float> ssim_scratch_;
+  uint64_t steps_ = 0;
+
+  mutable std::mutex frames_mutex_;
+  std::deque<std::shared_ptr<const StoredFrame>> recent_;
+  std::vector<std::shared_ptr<const StoredFrame>> keyframes_;
+
+  std::mutex step_mutex_;
+  mutable std::mutex snapshot_mutex_;
+  std::shared_ptr<const MapSnapshot> snapshot_;
+  uint64_t version_ = 0;
+
+  mutable std::mutex render_mutex_;
+  mutable Renderer query_renderer_;
+};
+
+}  // namespace rrg

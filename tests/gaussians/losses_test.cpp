@@ -1,0 +1,187 @@
+// Mapping losses: known answers, double-precision central finite differences of every gradient
+// (the same kernels instantiated in double), float-vs-double agreement and CPU/CUDA parity.
+#include "core/gaussians/losses.h"
+#include "core/gaussians/losses_impl.h"
+#include "tests/support/parity.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <random>
+#include <vector>
+
+namespace rrg {
+namespace {
+
+constexpr int W = 14, H = 12;
+
+std::vector<double> random_image(int w, int h, int channels, uint32_t seed, double lo = 0.0, double hi = 1.0) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(lo, hi);
+  std::vector<double> v(size_t(w) * h * channels);
+  for (double& x : v) x = u(rng);
+  return v;
+}
+
+kernel::SsimWindow<double> window_d() {
+  kernel::SsimWindow<double> w{};
+  double sum = 0;
+  for (int k = 0; k < 11; ++k) sum += (w.g[k] = std::exp(-(k - 5.0) * (k - 5.0) / (2 * 1.5 * 1.5)));
+  for (double& g : w.g) g /= sum;
+  w.c1 = 1e-4;
+  w.c2 = 9e-4;
+  return w;
+}
+
+Span<const double> cs(const std::vector<double>& v) { return {v.data(), int64_t(v.size())}; }
+Span<double> ms(std::vector<double>& v) { return {v.data(), int64_t(v.size())}; }
+
+// Checks grad against central differences of f at every index; skip(i, h) lets piecewise-linear
+// losses skip a scalar whose ±h straddles a kink. Returns the max error / max |grad|.
+double fd_check(std::vector<double>& x, const std::vector<double>& grad, const std::function<double()>& f, double h,
+                const std::function<bool(size_t)>& skip = {}) {
+  double max_err = 0, max_g = 1e-30;
+  size_t checked = 0;
+  for (size_t i = 0; i < x.size(); ++i) {
+    max_g = std::max(max_g, std::abs(grad[i]));
+    if (skip && skip(i)) continue;
+    const double x0 = x[i];
+    x[i] = x0 + h;
+    const double fp = f();
+    x[i] = x0 - h;
+    const double fm = f();
+    x[i] = x0;
+    max_err = std::max(max_err, std::abs((fp - fm) / (2 * h) - grad[i]));
+    ++checked;
+  }
+  EXPECT_GT(checked, x.size() / 2);
+  return max_err / max_g;
+}
+
+TEST(Losses, L1KnownAnswerAndFiniteDifferences) {
+  std::vector<double> x = random_image(W, H, 3, 1), y = random_image(W, H, 3, 2), g(x.size(), 0.0);
+  std::vector<double> none;
+  const double v = kernel::l1_loss_cpu<double>(cs(x), cs(y), ms(g), 0.7);
+  double ref = 0;
+  for (size_t i = 0; i < x.size(); ++i) ref += std::abs(x[i] - y[i]);
+  EXPECT_NEAR(v, ref / double(x.size()), 1e-12);
+  for (double& gi : g) gi /= 0.7;  // the gradient was added with weight 0.7
+  const double h = 1e-6;
+  const double err = fd_check(x, g, [&] { return kernel::l1_loss_cpu<double>(cs(x), cs(y), ms(none), 1.0); }, h,
+                              [&](size_t i) { return std::abs(x[i] - y[i]) < 10 * h; });
+  EXPECT_LT(err, 1e-6);
+}
+
+TEST(Losses, DepthL1IgnoresInvalidPixelsAndMatchesFiniteDifferences) {
+  std::vector<double> d = random_image(W, H, 1, 3, 0.5, 4.0), gt = random_image(W, H, 1, 4, 0.5, 4.0);
+  for (size_t i = 0; i < gt.size(); i += 3) gt[i] = 0.0;  // invalid
+  std::vector<double> g(d.size(), 0.0), none;
+  const double v = kernel::depth_l1_loss_cpu<double>(cs(d), cs(gt), ms(g), 1.0);
+  double ref = 0, n = 0;
+  for (size_t i = 0; i < d.size(); ++i)
+    if (gt[i] > 0) ref += std::abs(d[i] - gt[i]), n += 1;
+  EXPECT_NEAR(v, ref / n, 1e-12);
+  for (size_t i = 0; i < gt.size(); i += 3) EXPECT_EQ(g[i], 0.0);
+  const double err = fd_check(d, g, [&] { return kernel::depth_l1_loss_cpu<double>(cs(d), cs(gt), ms(none), 1.0); }, 1e-6,
+                              [&](size_t i) { return gt[i] > 0 && std::abs(d[i] - gt[i]) < 1e-5; });
+  EXPECT_LT(err, 1e-6);
+  std::vector<double> all_invalid(d.size(), 0.0);
+  EXPECT_EQ(kernel::depth_l1_loss_cpu<double>(cs(d), cs(all_invalid), ms(none), 1.0), 0.0);
+}
+
+TEST(Losses, SsimKnownAnswersAndFiniteDifferences) {
+  std::vector<double> x = random_image(W, H, 3, 5), y = random_image(W, H, 3, 6);
+  std::vector<double> scratch(size_t(W) * H * 36), g(x.size(), 0.0), none;
+  // SSIM(y, y) = 1 with a zero gradient (a maximum).
+  std::vector<double> gy(x.size(), 0.0);
+  EXPECT_NEAR(kernel::ssim_cpu<double>(W, H, cs(y), cs(y), ms(gy), 1.0, window_d(), ms(scratch)), 1.0, 1e-12);
+  for (double v : gy) EXPECT_NEAR(v, 0.0, 1e-12);
+  const double s = kernel::ssim_cpu<double>(W, H, cs(x), cs(y), ms(g), 1.0, window_d(), ms(scratch));
+  EXPECT_LT(s, 0.5);  // independent noise images are far from similar
+  const double err = fd_check(x, g, [&] {
+    return kernel::ssim_cpu<double>(W, H, cs(x), cs(y), ms(none), 1.0, window_d(), ms(scratch));
+  }, 1e-6);
+  EXPECT_LT(err, 1e-6);
+}
+
+TEST(Losses, SobelKnownAnswerAndFiniteDifferences) {
+  // A ramp I = a x in every channel: Gx = 8a, Gy = 0 everywhere inside.
+  std::vector<double> ramp(size_t(W) * H * 3), none;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x)
+      for (int c = 0; c < 3; ++c) ramp[(size_t(y) * W + x) * 3 + c] = 0.05 * x;
+  EXPECT_NEAR(kernel::sobel_l1_loss_cpu<double>(W, H, cs(ramp), ms(none), 1.0), 8 * 0.05, 1e-12);
+  std::vector<double> x = random_image(W, H, 3, 7), g(x.size(), 0.0);
+  kernel::sobel_l1_loss_cpu<double>(W, H, cs(x), ms(g), 1.0);
+  // A step of h moves a response by at most 4h: random data puts none that close to the kink at 0.
+  const double err = fd_check(x, g, [&] { return kernel::sobel_l1_loss_cpu<double>(W, H, cs(x), ms(none), 1.0); }, 1e-7);
+  EXPECT_LT(err, 1e-6);
+}
+
+ColorImage to_color(const std::vector<double>& v, int w, int h) {
+  ColorImage im(w, h);
+  for (size_t i = 0; i < im.size(); ++i) im[i] = Color(float(v[3 * i]), float(v[3 * i + 1]), float(v[3 * i + 2]));
+  return im;
+}
+
+// The float API (what the mapper runs) agrees with the double kernels, on every device.
+TEST(Losses, FloatApiMatchesDoubleAndDevicesAgree) {
+  const std::vector<double> xd = random_image(W, H, 3, 8), yd = random_image(W, H, 3, 9), rd = random_image(W, H, 3, 10);
+  const std::vector<double> dd = random_image(W, H, 1, 11, 1, 3), gtd = random_image(W, H, 1, 12, 1, 3);
+  // double reference of the whole loss and its gradients
+  std::vector<double> scratch(size_t(W) * H * 36), vC(xd.size(), 0.0), vD(dd.size(), 0.0), vR(rd.size(), 0.0);
+  const double l1 = kernel::l1_loss_cpu<double>(cs(xd), cs(yd), ms(vC), 0.8);
+  const double ss = kernel::ssim_cpu<double>(W, H, cs(xd), cs(yd), ms(vC), -0.2, window_d(), ms(scratch));
+  const double dl = kernel::depth_l1_loss_cpu<double>(cs(dd), cs(gtd), ms(vD), 0.2);
+  const double sb = kernel::sobel_l1_loss_cpu<double>(W, H, cs(rd), ms(vR), 0.05);
+  const double total = 0.8 * l1 + 0.2 * (1 - ss) + 0.2 * dl + 0.05 * sb;
+
+  const ColorImage X = to_color(xd, W, H), Y = to_color(yd, W, H), Rr = to_color(rd, W, H);
+  DepthImage D(W, H), G(W, H);
+  for (size_t i = 0; i < D.size(); ++i) D[i] = float(dd[i]), G[i] = float(gtd[i]);
+  const auto got = test::expect_device_parity<double>(
+      [&](const Device& dev) {
+        const auto C = DeviceImage<Color>::from_host(X, dev), Cgt = DeviceImage<Color>::from_host(Y, dev);
+        const auto Cr = DeviceImage<Color>::from_host(Rr, dev);
+        const auto Db = DeviceImage<float>::from_host(D, dev), Dgt = DeviceImage<float>::from_host(G, dev);
+        DeviceImage<Color> v_C, v_Cr;
+        DeviceImage<float> v_D;
+        Buffer<float> sc;
+        const LossValues L = mapping_loss(C, Cgt, Db, Dgt, &Cr, LossWeights{}, v_C, v_D, v_Cr, sc);
+        std::vector<double> out = {L.total, L.l1, L.ssim, L.depth_l1, L.sobel};
+        const ColorImage hC = v_C.to_host(), hCr = v_Cr.to_host();
+        const DepthImage hD = v_D.to_host();
+        for (const Color& c : hC.pixels()) out.insert(out.end(), {c.x(), c.y(), c.z()});
+        for (float v : hD.pixels()) out.push_back(v);
+        for (const Color& c : hCr.pixels()) out.insert(out.end(), {c.x(), c.y(), c.z()});
+        return out;
+      },
+      1e-6, 1e-4);
+  EXPECT_NEAR(got[0], total, 1e-5);
+  EXPECT_NEAR(got[1], l1, 1e-6);
+  EXPECT_NEAR(got[2], ss, 1e-5);
+  EXPECT_NEAR(got[3], dl, 1e-6);
+  EXPECT_NEAR(got[4], sb, 1e-5);
+  size_t k = 5;
+  double max_g = 0, max_err = 0;
+  for (const auto* ref : {&vC, &vD, &vR})
+    for (double r : *ref) {
+      max_g = std::max(max_g, std::abs(r));
+      max_err = std::max(max_err, std::abs(got[k++] - r));
+    }
+  EXPECT_EQ(k, got.size());
+  EXPECT_LT(max_err, 1e-4 * max_g);
+}
+
+TEST(Losses, RejectsMismatchedImages) {
+  const auto a = DeviceImage<Color>::from_host(ColorImage(4, 4), Device::cpu());
+  const auto b = DeviceImage<Color>::from_host(ColorImage(5, 4), Device::cpu());
+  EXPECT_THROW(l1_loss(a, b, nullptr, 1.0f), std::invalid_argument);
+  LossWeights w;
+  w.lambda_ssim = 2.0f;
+  EXPECT_THROW(w.validate(), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace rrg
