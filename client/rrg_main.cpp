@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   rrg::cli::register_fuse_command(app);
   rrg::cli::register_track_command(app);
   rrg::cli::register_planes_command(app);
+  rrg::cli::register_run_command(app);
 
   try {
     app.parse(argc, argv);

@@ -16,5 +16,6 @@ void register_device_command(CLI::App& app);   // rrg devices
 void register_fuse_command(CLI::App& app);     // rrg fuse (TSDF from a posed dataset -> mesh)
 void register_track_command(CLI::App& app);    // rrg track (tracking + TSDF fusion on a dataset)
 void register_planes_command(CLI::App& app);   // rrg planes (reflective plane identification)
+void register_run_command(CLI::App& app);      // rrg run (the whole pipeline on a dataset, with evaluation)
 
 }  // namespace rrg::cli

@@ -44,6 +44,12 @@ void Tracker::set_pose_prior(const Eigen::Isometry3f& T_wc) {
   velocity_ = Eigen::Isometry3f::Identity();
 }
 
+void Tracker::resume(const Eigen::Isometry3f& T_wc) {
+  started_ = true;
+  T_initial_ = T_prev_ = T_wc;
+  velocity_ = Eigen::Isometry3f::Identity();
+}
+
 bool Tracker::icp_failed(const IcpResult& icp) const {
   return icp.diverged || icp.valid == 0 || icp.inlier_ratio < params_.icp.min_inlier_ratio;
 }

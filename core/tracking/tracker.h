@@ -56,6 +56,9 @@ class Tracker {
   // Replaces the motion prior: the next frame is predicted at T_wc with zero velocity (an external
   // pose prior, or a kidnapped camera in tests).
   void set_pose_prior(const Eigen::Isometry3f& T_wc);
+  // Continues a stream that stopped at T_wc (a restored session snapshot): the next frame is tracked
+  // against the model, predicted at T_wc with zero velocity; no keyframes are kept.
+  void resume(const Eigen::Isometry3f& T_wc);
 
   // Tracks one frame. `model` serves the map raycast (not used on the first frame); `masks` gives
   // R_k^track in icp+orb+mask mode (required there). Throws std::invalid_argument on size mismatch.

@@ -1,0 +1,330 @@
+#include "core/slam/runner.h"
+
+#include "core/eval/image_metrics.h"
+#include "core/eval/mesh_metrics.h"
+#include "core/eval/trajectory_metrics.h"
+#include "core/io/atomic_file.h"
+#include "core/io/draco_mesh.h"
+#include "core/io/image_io.h"
+#include "core/io/ply.h"
+#include "core/io/synth_layout.h"
+#include "core/io/trajectory.h"
+#include "core/planes/semantic_labels.h"
+#include "core/slam/run_outputs.h"
+
+#include <nlohmann/json.hpp>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+namespace rrg {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+// Pooled squared error over masked pixels, for PSNR over the reflective pixels of many views.
+struct MaskedSse {
+  double sse = 0;
+  size_t pixels = 0;
+  void add(const ColorImage& est, const ColorImage& ref, const MaskImage& mask) {
+    for (int y = 0; y < ref.height(); ++y)
+      for (int x = 0; x < ref.width(); ++x)
+        if (mask(x, y)) {
+          sse += double((est(x, y) - ref(x, y)).squaredNorm());
+          ++pixels;
+        }
+  }
+  double psnr() const { return pixels ? 10.0 * std::log10(1.0 / (sse / double(3 * pixels))) : 0.0; }
+};
+
+struct ScoreAccumulator {
+  double psnr = 0, ssim = 0;
+  size_t views = 0;
+  MaskedSse reflective;
+  void add(const ColorImage& est, const ColorImage& ref, const MaskImage* reflection) {
+    psnr += std::min(eval::psnr(est, ref), 100.0);
+    ssim += eval::ssim(est, ref);
+    ++views;
+    if (reflection) reflective.add(est, ref, *reflection);
+  }
+  ImageScores scores() const {
+    ImageScores s;
+    s.views = views;
+    if (views) s.psnr = psnr / double(views), s.ssim = ssim / double(views);
+    s.psnr_reflective = reflective.psnr();
+    s.reflective_pixels = reflective.pixels;
+    return s;
+  }
+};
+
+// A one-line progress bar with live FPS on stderr (rewritten in place on a terminal).
+class ProgressBar {
+ public:
+  ProgressBar(size_t total, bool enabled) : total_(total), enabled_(enabled), t0_(Clock::now()) {}
+  void update(size_t done, const std::string& extra) {
+    if (!enabled_) return;
+    const double s = ms_since(t0_) / 1000.0;
+    const bool last = done == total_;
+    if (!last && s - last_s_ < 0.5) return;
+    last_s_ = s;
+    const int width = 30, filled = int(double(width) * double(done) / double(std::max<size_t>(1, total_)));
+    std::fprintf(stderr, "\r[%s%s] %zu/%zu  %.1f FPS  %s", std::string(size_t(filled), '#').c_str(),
+                 std::string(size_t(width - filled), '.').c_str(), done, total_, s > 0 ? double(done) / s : 0.0,
+                 extra.c_str());
+    if (last) std::fprintf(stderr, "\n");
+    std::fflush(stderr);
+  }
+
+ private:
+  size_t total_;
+  bool enabled_;
+  Clock::time_point t0_;
+  double last_s_ = -1;
+};
+
+std::string choose_semantics(const RunOptions& o, const io::Dataset& dataset, SessionConfig& config) {
+  std::string s = o.semantics;
+  const bool has_labels = dataset.format() == io::DatasetFormat::Synth &&
+                          std::filesystem::exists(io::synth_scene_file(dataset.root(), "categories.json"));
+  if (s == "auto") s = has_labels ? "labels" : "none";
+  if (s == "labels") {
+    if (!has_labels)
+      throw std::invalid_argument("run: --semantics labels needs label images and categories.json (a synthetic dataset); " +
+                                  dataset.root().string() + " has none (use none or remote)");
+    if (config.categories.empty())
+      for (const auto& [id, name] : read_category_table(io::synth_scene_file(dataset.root(), "categories.json")).names)
+        config.categories[id] = name;
+  }
+  return s;
+}
+
+}  // namespace
+
+std::vector<NamedPose> read_render_poses(const std::filesystem::path& file) {
+  std::ifstream f(file);
+  if (!f) throw std::runtime_error("render poses: cannot open " + file.string());
+  std::vector<NamedPose> poses;
+  std::string line;
+  for (size_t line_no = 1; std::getline(f, line); ++line_no) {
+    const auto hash = line.find('#');
+    if (hash != std::string::npos) line.resize(hash);
+    std::istringstream in(line);
+    std::string name;
+    if (!(in >> name)) continue;
+    double v[7];
+    for (double& x : v)
+      if (!(in >> x) || !std::isfinite(x))
+        throw std::runtime_error("render poses: " + file.string() + ":" + std::to_string(line_no) +
+                                 ": expected 'name tx ty tz qx qy qz qw'");
+    Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
+    if (std::abs(q.norm() - 1.0) > 0.1)
+      throw std::runtime_error("render poses: " + file.string() + ":" + std::to_string(line_no) + ": quaternion is not unit");
+    q.normalize();
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = q.toRotationMatrix();
+    T.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
+    char* end = nullptr;
+    std::strtod(name.c_str(), &end);
+    if (end && *end == '\0') {  // a TUM line: the first column is a timestamp
+      char buf[16];
+      std::snprintf(buf, sizeof(buf), "%06zu", poses.size());
+      name = buf;
+    }
+    for (char& c : name)
+      if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.')) c = '_';
+    poses.push_back({name, T.cast<float>()});
+  }
+  return poses;
+}
+
+RunResult run_dataset(const RunOptions& o) {
+  const auto dataset = io::open_dataset(o.dataset, o.dataset_options);
+  SessionConfig config = o.config;
+  config.K = dataset->intrinsics();
+  config.semantics = choose_semantics(o, *dataset, config);
+  if (config.gt_poses && !dataset->has_ground_truth())
+    throw std::invalid_argument("run: --gt-poses needs a dataset with ground-truth poses");
+  const size_t n = o.max_frames > 0 ? std::min(dataset->size(), o.max_frames) : dataset->size();
+  if (n == 0) throw std::invalid_argument("run: " + o.dataset.string() + " has no frames");
+  if (!o.out.empty()) std::filesystem::create_directories(o.out);
+  if (!o.out.empty())
+    io::write_atomically(o.out / "config.yaml", [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << config_to_yaml(config); });
+
+  Session session(config);
+  spdlog::info("run: {} ({} frames, {}x{}) on {}, tracking {}, semantics {}, reflections {}, {}", o.dataset.string(), n,
+               config.K.width, config.K.height, config.device.to_string(),
+               config.gt_poses ? "off (ground-truth poses)" : to_string(config.tracking.mode), config.semantics,
+               config.mapping.reflections ? "on" : "off", config.sync ? "sync" : "overlapped mapping");
+
+  RunResult result;
+  ProgressBar bar(n, o.progress);
+  ScoreAccumulator train;
+  std::vector<std::pair<size_t, ColorImage>> train_views;  // scored at the end (the final map)
+  double load_ms = 0;
+  const auto wall0 = Clock::now();
+  for (size_t i = 0; i < n; ++i) {
+    auto t0 = Clock::now();
+    io::Frame f = dataset->load(i);
+    SessionFrame frame;
+    frame.index = int64_t(i);
+    frame.timestamp = f.timestamp;
+    frame.color = std::move(f.color);
+    frame.depth = std::move(f.depth);
+    if (config.semantics == "labels") frame.labels = io::read_synth_labels(dataset->root(), i);
+    if (f.T_wc_gt && (i == 0 || config.gt_poses)) frame.pose = f.T_wc_gt->cast<float>();
+    load_ms += ms_since(t0);
+    const FrameReport r = session.process(frame);
+    if (r.state == TrackingState::Lost) spdlog::debug("run: frame {} lost: {}", i, r.note);
+    if (o.train_stride > 0 && i % o.train_stride == 0) train_views.emplace_back(i, std::move(frame.color));
+    const SessionStatus st = session.status();
+    bar.update(i + 1, fmt::format("{} G_b {} G_r {} planes", st.mapping.base_gaussians, st.mapping.reflection_gaussians,
+                                  st.reflective_planes.size()));
+  }
+  session.finish();
+  const double wall_ms = ms_since(wall0);
+
+  // --- timings ---
+  const auto reports = session.reports();
+  const SessionStatus st = session.status();
+  RunTimings& t = result.timings;
+  for (const FrameReport& r : reports) {
+    t.mean.raycast += r.times.raycast, t.mean.preprocess += r.times.preprocess, t.mean.icp += r.times.icp;
+    t.mean.orb += r.times.orb, t.mean.fuse += r.times.fuse, t.mean.identify += r.times.identify;
+    t.mean.mapping += r.times.mapping, t.mean.total += r.times.total;
+  }
+  const double per = 1.0 / double(reports.size());
+  for (double* v : {&t.mean.raycast, &t.mean.preprocess, &t.mean.icp, &t.mean.orb, &t.mean.fuse, &t.mean.identify,
+                    &t.mean.mapping, &t.mean.total})
+    *v *= per;
+  t.premapping_ms = t.mean.raycast + t.mean.preprocess + t.mean.icp + t.mean.orb + t.mean.fuse + t.mean.identify;
+  t.mapping_steps = st.mapping.steps;
+  t.mapping_step_ms = st.mapping.steps ? st.mapping.ms_total / double(st.mapping.steps) : 0.0;
+  t.load_ms = load_ms / double(n);
+  t.wall_ms_per_frame = wall_ms / double(n);
+
+  // --- metrics ---
+  RunMetrics& m = result.metrics;
+  m.frames = n;
+  m.lost = size_t(st.lost);
+  m.wall_s = wall_ms / 1000.0;
+  m.fps = double(n) / m.wall_s;
+  m.base_gaussians = st.mapping.base_gaussians;
+  m.reflection_gaussians = st.mapping.reflection_gaussians;
+  m.reflective_planes = int64_t(st.reflective_planes.size());
+  result.trajectory = session.trajectory();
+  if (dataset->has_ground_truth()) {
+    io::Trajectory gt = dataset->ground_truth();
+    if (gt.size() > n) gt.resize(n);
+    m.ate_rmse_cm = eval::evaluate_trajectory(result.trajectory, gt).ate.rmse_cm;
+  }
+  const bool synth = dataset->format() == io::DatasetFormat::Synth;
+  RunOutputs outputs(o.out, o.write_renders);
+  for (const auto& [i, gt_color] : train_views) {
+    const SessionView v = session.render(config.K, reports[i].T_wc);
+    const MaskImage reflection = synth ? io::read_synth_reflection(dataset->root(), i) : MaskImage();
+    train.add(v.C, gt_color, synth ? &reflection : nullptr);
+  }
+  m.train = train.scores();
+  for (size_t i : o.decomposition_frames) {
+    if (i >= n) throw std::invalid_argument("run: --decomposition frame " + std::to_string(i) + " is beyond the run");
+    const io::Frame f = dataset->load(i);
+    outputs.decomposition(i, session.render(config.K, reports[i].T_wc), f.color);
+  }
+  if (synth && std::filesystem::exists(o.dataset / "novel")) {  // held-out views, never optimised on
+    const auto novel = io::open_dataset(o.dataset / "novel");
+    ScoreAccumulator held;
+    for (size_t i = 0; i < novel->size(); ++i) {
+      const io::Frame f = novel->load(i);
+      if (!f.T_wc_gt) continue;
+      const SessionView v = session.render(novel->intrinsics(), f.T_wc_gt->cast<float>());
+      const MaskImage reflection = io::read_synth_reflection(o.dataset / "novel", i);
+      held.add(v.C, f.color, &reflection);
+      outputs.render("novel_" + std::to_string(i), v, &f.color);
+    }
+    m.held_out = held.scores();
+  }
+  if (!o.render_poses.empty())
+    for (const NamedPose& p : read_render_poses(o.render_poses))
+      outputs.render(p.name, session.render(config.K, p.T_wc), nullptr);
+
+  TriangleMesh mesh;
+  if (o.write_mesh || synth) mesh = session.mesh();
+  if (synth && std::filesystem::exists(io::synth_scene_file(o.dataset, "mesh_gt.ply")) && !mesh.triangles.empty()) {
+    const TriangleMesh gt = io::read_ply_mesh(io::synth_scene_file(o.dataset, "mesh_gt.ply"));
+    eval::MeshEvalParams mp;
+    const eval::MeshMetrics mm = eval::evaluate_mesh(mesh, gt, mp);
+    m.accuracy_cm = mm.accuracy_cm;
+    m.completion_cm = mm.completion_cm;
+    m.completion_ratio = mm.completion_ratio;
+  }
+
+  // --- files ---
+  if (!o.out.empty()) {
+    io::write_tum_trajectory(o.out / "trajectory.txt", result.trajectory);
+    if (o.write_mesh && !mesh.triangles.empty()) outputs.mesh(mesh);
+    if (o.write_gaussians) outputs.gaussians(session.base_gaussians(), session.reflection_gaussians(), session.reflective_planes());
+    io::write_atomically(o.out / "metrics.json", [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << metrics_json(m); });
+    io::write_atomically(o.out / "timings.json", [&](const std::filesystem::path& tmp) {
+      std::ofstream(tmp) << timings_json(t, config.device.to_string());
+    });
+  }
+  return result;
+}
+
+std::string metrics_json(const RunMetrics& m) {
+  nlohmann::ordered_json j;
+  j["frames"] = m.frames;
+  j["lost"] = m.lost;
+  if (m.ate_rmse_cm) j["ate_rmse_cm"] = *m.ate_rmse_cm;
+  j["ate_alignment"] = "rigid SE(3) Umeyama, no scale";
+  auto scores = [](const ImageScores& s) {
+    nlohmann::ordered_json x;
+    x["views"] = s.views;
+    x["psnr_db"] = s.psnr;
+    x["ssim"] = s.ssim;
+    x["psnr_reflective_db"] = s.psnr_reflective;
+    x["reflective_pixels"] = s.reflective_pixels;
+    return x;
+  };
+  j["train"] = scores(m.train);
+  j["held_out"] = scores(m.held_out);
+  if (m.accuracy_cm) {
+    j["geometry"]["accuracy_cm"] = *m.accuracy_cm;
+    j["geometry"]["completion_cm"] = *m.completion_cm;
+    j["geometry"]["completion_ratio_3cm"] = *m.completion_ratio;
+  }
+  j["wall_s"] = m.wall_s;
+  j["fps"] = m.fps;
+  j["base_gaussians"] = m.base_gaussians;
+  j["reflection_gaussians"] = m.reflection_gaussians;
+  j["reflective_planes"] = m.reflective_planes;
+  return j.dump(2) + "\n";
+}
+
+std::string timings_json(const RunTimings& t, const std::string& device) {
+  nlohmann::ordered_json j;
+  j["device"] = device;
+  j["unit"] = "ms per frame unless named per step";
+  j["load"] = t.load_ms;
+  j["raycast"] = t.mean.raycast;
+  j["preprocess"] = t.mean.preprocess;
+  j["icp"] = t.mean.icp;
+  j["orb"] = t.mean.orb;
+  j["fuse"] = t.mean.fuse;
+  j["identify"] = t.mean.identify;
+  j["premapping"] = t.premapping_ms;
+  j["mapping_wait_or_inline"] = t.mean.mapping;
+  j["mapping_step_per_step"] = t.mapping_step_ms;
+  j["mapping_steps"] = t.mapping_steps;
+  j["process_total"] = t.mean.total;
+  j["wall_per_frame"] = t.wall_ms_per_frame;
+  j["fps"] = t.wall_ms_per_frame > 0 ? 1000.0 / t.wall_ms_per_frame : 0.0;
+  return j.dump(2) + "\n";
+}
+
+}  // namespace rrg

@@ -1,0 +1,79 @@
+#pragma once
+// The offline runner behind `rrg run` (paper §5's protocol): feeds a dataset through a Session,
+// then writes and scores everything a user and the paper's tables need:
+//   trajectory.txt (TUM), mesh.ply + mesh.drc, Gaussians (PLY + SPZ, base and reflection),
+//   renders of held-out views and of --render-poses, decomposition images (C_b, R, R·C_r, C, GT),
+//   timings.json, metrics.json (ATE; PSNR/SSIM on training and held-out views; PSNR on reflective
+//   pixels; geometry accuracy/completion against a ground-truth mesh), config.yaml.
+#include "core/io/dataset.h"
+#include "core/slam/session.h"
+
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace rrg {
+
+struct RunOptions {
+  std::filesystem::path dataset;
+  io::DatasetOptions dataset_options;
+  std::filesystem::path out;                 // empty: nothing written (tests)
+  SessionConfig config;                      // K is taken from the dataset
+  std::string semantics = "auto";            // auto: labels when the dataset has label images, else none
+  size_t max_frames = 0;                     // 0 = all
+  size_t train_stride = 10;                  // every N-th frame is scored as a training view
+  std::vector<size_t> decomposition_frames;  // frames whose C_b, R, R·C_r, C and GT images are written
+  std::filesystem::path render_poses;        // file of poses to render at the end
+  bool write_gaussians = true, write_mesh = true, write_renders = true;
+  bool progress = true;                      // progress bar with live FPS on stderr
+};
+
+// One named pose to render: "name tx ty tz qx qy qz qw", or a TUM line (the name is then the
+// line's index, 6 digits). Throws std::runtime_error naming the file and line.
+struct NamedPose {
+  std::string name;
+  Eigen::Isometry3f T_wc;
+};
+std::vector<NamedPose> read_render_poses(const std::filesystem::path& file);
+
+struct ImageScores {
+  size_t views = 0;
+  double psnr = 0, ssim = 0;          // means over views
+  double psnr_reflective = 0;         // PSNR over the pooled reflective pixels (ground-truth mask)
+  size_t reflective_pixels = 0;
+};
+
+struct RunMetrics {
+  size_t frames = 0, lost = 0;
+  std::optional<double> ate_rmse_cm;          // rigid SE(3) Umeyama alignment
+  ImageScores train, held_out;                // held_out only with a novel/ folder (synth)
+  std::optional<double> accuracy_cm, completion_cm, completion_ratio;  // with a ground-truth mesh
+  double wall_s = 0, fps = 0;                 // whole run, frames / wall time (loading included)
+  int64_t base_gaussians = 0, reflection_gaussians = 0, reflective_planes = 0;
+};
+
+struct RunTimings {
+  StageTimes mean;                 // per frame, over frames
+  double mapping_step_ms = 0;      // per mapping step (on the mapping thread unless sync)
+  int64_t mapping_steps = 0;
+  double load_ms = 0;              // dataset reading, per frame
+  double premapping_ms = 0;        // raycast + preprocess + icp + orb + fuse + identify, per frame
+  double wall_ms_per_frame = 0;
+};
+
+struct RunResult {
+  RunMetrics metrics;
+  RunTimings timings;
+  io::Trajectory trajectory;
+};
+
+// Runs the whole pipeline. `progress_line` (optional) receives a line now and then for logs.
+RunResult run_dataset(const RunOptions& options);
+
+// metrics.json / timings.json bodies (also printed by `rrg run`).
+std::string metrics_json(const RunMetrics& m);
+std::string timings_json(const RunTimings& t, const std::string& device);
+
+}  // namespace rrg

@@ -1,0 +1,316 @@
+// The session's schedule (paper §4): pre-mapping per frame, identification every N_p frames,
+// mapping every N_o frames on the mapping thread (or inline with config.sync).
+#include "core/slam/session_impl.h"
+
+#include "core/planes/remote_segmenter.h"
+#include "core/planes/semantic_labels.h"
+#include "core/tsdf/tsdf_integrate.h"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <stdexcept>
+
+namespace rrg {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+std::unique_ptr<SemanticCue> cue_from_config(const SessionConfig& c) {
+  const std::vector<std::string> prompts = c.prompts.empty() ? default_prompts() : c.prompts;
+  if (c.semantics == "none") return make_no_semantics();
+  if (c.semantics == "labels") {
+    CategoryTable table;
+    for (const auto& [id, name] : c.categories) table.names[id] = name;
+    return make_label_semantics(std::move(table), prompts);
+  }
+  RemoteSegmenterOptions o;
+  o.address = c.remote_address;
+  o.prompts = prompts;
+  return make_remote_semantics(o);
+}
+
+SessionConfig validated(SessionConfig c) {
+  c.validate();
+  return c;
+}
+
+}  // namespace
+
+// --- the mapping thread --------------------------------------------------------------------------
+
+void MappingWorker::start(std::function<void()> job) {
+  std::unique_lock lock(m_);
+  cv_.wait(lock, [&] { return !running_; });
+  if (!thread_.joinable()) thread_ = std::thread([this] { loop(); });
+  job_ = std::move(job);
+  running_ = true;
+  cv_.notify_all();
+}
+
+void MappingWorker::wait() {
+  std::unique_lock lock(m_);
+  cv_.wait(lock, [&] { return !running_; });
+  if (error_) std::rethrow_exception(std::exchange(error_, nullptr));
+}
+
+bool MappingWorker::busy() const {
+  std::lock_guard lock(m_);
+  return running_;
+}
+
+void MappingWorker::stop() {
+  {
+    std::unique_lock lock(m_);
+    cv_.wait(lock, [&] { return !running_; });
+    quit_ = true;
+    cv_.notify_all();
+  }
+  if (thread_.joinable()) thread_.join();
+}
+
+void MappingWorker::loop() {
+  std::unique_lock lock(m_);
+  for (;;) {
+    cv_.wait(lock, [&] { return quit_ || (running_ && job_); });
+    if (quit_ && !running_) return;
+    auto job = std::move(job_);
+    job_ = nullptr;
+    lock.unlock();
+    std::exception_ptr error;
+    try {
+      job();
+    } catch (...) {
+      error = std::current_exception();
+    }
+    lock.lock();
+    if (error) error_ = error;
+    running_ = false;
+    cv_.notify_all();
+  }
+}
+
+// --- construction ----------------------------------------------------------------------------------
+
+Session::Impl::Impl(SessionConfig c, std::unique_ptr<SemanticCue> cue)
+    : config(validated(std::move(c))),
+      K(config.K),
+      volume(config.tsdf, config.device),
+      model(volume, K, volume_mutex),
+      tracker(config.tracking, K, config.device),
+      identifier(config.planes, cue ? std::move(cue) : cue_from_config(config)),
+      mapper(config.mapping, K, config.device) {
+  if (config.tracking.mode == TrackingMode::IcpOrbMask && !config.gt_poses)
+    masks = std::make_unique<RenderedReflectionMasks>(
+        [this](size_t, const Eigen::Isometry3f& T_wc) { return render_reflection(T_wc); },
+        config.tracking.orb.mask_threshold);
+}
+
+Session::Session(SessionConfig config, std::unique_ptr<SemanticCue> cue)
+    : impl_(std::make_unique<Impl>(std::move(config), std::move(cue))) {
+  spdlog::debug("session: {}x{} on {}, tracking {}, semantics {}, mapping every {} frames{}", impl_->K.width,
+                impl_->K.height, impl_->config.device.to_string(), to_string(impl_->config.tracking.mode),
+                impl_->identifier.cue().name(), impl_->config.mapping_period, impl_->config.sync ? " (sync)" : "");
+}
+
+Session::~Session() {
+  if (impl_) {
+    try {
+      impl_->worker.wait();
+    } catch (const std::exception& e) {
+      spdlog::error("session: mapping step failed while closing: {}", e.what());
+    }
+    impl_->worker.stop();
+  }
+}
+
+const SessionConfig& Session::config() const { return impl_->config; }
+
+// --- helpers ----------------------------------------------------------------------------------------
+
+RaycastResult Session::Impl::locked_raycast(const Intrinsics& K_, const Eigen::Isometry3f& T_wc) const {
+  const std::vector<int32_t> ids = remap_copy();
+  std::lock_guard lock(volume_mutex);
+  return raycast(volume, K_, T_wc, ids);
+}
+
+ColorImage Session::Impl::render_reflection(const Eigen::Isometry3f& T_wc) {
+  const auto snap = mapper.snapshot();
+  if (!snap || snap->reflection.size() == 0) return ColorImage(K.width, K.height, Color::Zero());
+  const RaycastResult rc = locked_raycast(K, T_wc);
+  RenderOutputs out;
+  mapper.render(RenderCamera{K, T_wc}, rc, out);
+  return out.C_r.to_host();
+}
+
+MappingContext Session::Impl::mapping_context() {
+  MappingContext ctx;
+  ctx.raycast = [this](const Intrinsics& K_, const Eigen::Isometry3f& T_wc) { return locked_raycast(K_, T_wc); };
+  if (config.mapping.reflections) {
+    std::lock_guard lock(state_mutex);
+    for (const ReflectivePlane& p : reflective) ctx.planes.push_back({p.id, p.plane});
+  }
+  return ctx;
+}
+
+// Plane identification (§4.1.3) at the tracked pose, before this frame is fused.
+void Session::Impl::identify(const SessionFrame& frame, const Eigen::Isometry3f& T_wc, FrameReport& report,
+                             DeviceImage<int32_t>& plane_ids, DeviceImage<uint8_t>& mask) {
+  const auto t0 = Clock::now();
+  const Image<float> cvar = locked_raycast(K, T_wc).color_variance.to_host();
+  IdentificationFrame f{&frame.depth, &frame.color, frame.labels ? &*frame.labels : nullptr, K, T_wc, frame.index};
+  if (identifier.cue().name() == "labels" && !frame.labels) f.labels = nullptr;
+  IdentificationResult r = identifier.identify(f, cvar);
+  plane_ids = DeviceImage<int32_t>::from_host(r.global_map, config.device);
+  mask = DeviceImage<uint8_t>::from_host(r.reflection_mask, config.device);
+  std::vector<ReflectivePlane> accepted;
+  for (int id : identifier.vote().lookup_table()) {
+    const GlobalPlane* g = identifier.table().find(id);
+    if (!g) continue;
+    accepted.push_back({g->id, Eigen::Vector4f(g->plane.n.x(), g->plane.n.y(), g->plane.n.z(), g->plane.d)});
+  }
+  {
+    std::lock_guard lock(state_mutex);
+    reflective = std::move(accepted);
+    remap = std::move(r.remap);
+    global_planes = identifier.table().live_ids().size();
+  }
+  report.identified = true;
+  report.times.identify = ms_since(t0);
+}
+
+// Hands the fused frames to the mapper and runs a step: inline (sync) or on the mapping thread.
+void Session::Impl::schedule_mapping(FrameReport& report) {
+  const auto t0 = Clock::now();
+  worker.wait();  // the previous step (async) must be done before the mapper takes new frames
+  for (size_t i = 0; i < pending.size(); ++i) mapper.add_frame(std::move(pending[i]), pending_keyframe[i]);
+  pending.clear();
+  pending_keyframe.clear();
+  auto job = [this, ctx = mapping_context()]() {
+    const MappingStats s = mapper.step(ctx);
+    std::lock_guard lock(state_mutex);
+    ++mapping.steps;
+    mapping.ms_total += s.ms_total;
+    mapping.last_loss = s.loss;
+    mapping.base_gaussians = int64_t(mapper.snapshot() ? mapper.snapshot()->base.size() : 0);
+    mapping.reflection_gaussians = int64_t(mapper.snapshot() ? mapper.snapshot()->reflection.size() : 0);
+    map_version.fetch_add(1);
+  };
+  if (config.sync) {
+    job();
+  } else {
+    worker.start(std::move(job));
+  }
+  report.mapping_started = true;
+  report.times.mapping = ms_since(t0);
+}
+
+// --- process -----------------------------------------------------------------------------------------
+
+FrameReport Session::process(const SessionFrame& frame) {
+  Impl& s = *impl_;
+  const auto t0 = Clock::now();
+  if (frame.color.width() != s.K.width || frame.color.height() != s.K.height)
+    throw std::invalid_argument("frame " + std::to_string(frame.index) + ": colour is " + std::to_string(frame.color.width()) +
+                                "x" + std::to_string(frame.color.height()) + ", the session expects " +
+                                std::to_string(s.K.width) + "x" + std::to_string(s.K.height));
+  if (frame.depth.width() != s.K.width || frame.depth.height() != s.K.height)
+    throw std::invalid_argument("frame " + std::to_string(frame.index) + ": depth is " + std::to_string(frame.depth.width()) +
+                                "x" + std::to_string(frame.depth.height()) + ", the session expects " +
+                                std::to_string(s.K.width) + "x" + std::to_string(s.K.height));
+  if (frame.labels && (frame.labels->width() != s.K.width || frame.labels->height() != s.K.height))
+    throw std::invalid_argument("frame " + std::to_string(frame.index) + ": label image size differs from the session's");
+  if (frame.index <= s.last_index)
+    throw std::invalid_argument("frame id " + std::to_string(frame.index) + " is not above the last one (" +
+                                std::to_string(s.last_index) + ")");
+  if (s.config.gt_poses && !frame.pose)
+    throw std::invalid_argument("frame " + std::to_string(frame.index) + ": gt_poses is set but the frame has no pose");
+
+  FrameReport report;
+  report.index = frame.index;
+  report.timestamp = frame.timestamp;
+  const auto depth = DeviceImage<float>::from_host(frame.depth, s.config.device);
+  const auto color = DeviceImage<Color>::from_host(frame.color, s.config.device);
+
+  // 1. tracking (§4.1.2), or the given pose. Mapping keyframes are the tracker's keyframes (the
+  // first frame included); with given poses, every N_o-th fused frame.
+  bool keyframe = false;
+  if (s.config.gt_poses) {
+    keyframe = s.fused % s.config.mapping_period == 0;
+    report.T_wc = *frame.pose;
+    report.state = TrackingState::Ok;
+  } else {
+    if (s.frames == 0 && frame.pose) s.tracker.set_initial_pose(*frame.pose);
+    else if (frame.pose) s.tracker.set_pose_prior(*frame.pose);
+    if (s.frames > 0) {
+      const auto tr = Clock::now();
+      s.model.model_at(s.T_last);
+      report.times.raycast = ms_since(tr);
+    }
+    const TrackResult r = s.tracker.track({size_t(frame.index), &frame.color, &frame.depth, &depth}, s.model, s.masks.get());
+    report.T_wc = r.T_wc;
+    report.state = r.state;
+    report.note = r.note;
+    report.times.preprocess = r.ms_preprocess;
+    report.times.icp = r.ms_icp;
+    report.times.orb = r.ms_orb;
+    keyframe = r.keyframe || r.first;
+  }
+
+  // 2. identification every N_p frames (§4.1.3), then 3. fusion (§4.1.4)
+  if (report.state != TrackingState::Lost) {
+    DeviceImage<int32_t> plane_ids;
+    DeviceImage<uint8_t> mask;
+    const bool identify = s.fused % s.config.plane_period == 0;
+    if (identify) s.identify(frame, report.T_wc, report, plane_ids, mask);
+    const auto tf = Clock::now();
+    {
+      std::lock_guard lock(s.volume_mutex);
+      const ReflectionObservation obs{&plane_ids, &mask, s.remap};  // written by this thread only
+      integrate(s.volume, depth, color, s.K, report.T_wc, identify ? &obs : nullptr);
+    }
+    s.model.invalidate();
+    report.times.fuse = ms_since(tf);
+    report.fused = true;
+    ++s.fused;
+    s.map_version.fetch_add(1);
+    s.pending.push_back(MappingFrame{frame.index, report.T_wc, frame.color, frame.depth});
+    s.pending_keyframe.push_back(keyframe);
+    // 4. a mapping step every N_o fused frames (§4.2)
+    if (s.fused % s.config.mapping_period == 0) s.schedule_mapping(report);
+  } else {
+    ++s.lost;
+  }
+  ++s.frames;
+  s.last_index = frame.index;
+  s.T_last = report.T_wc;
+  report.map_version = s.map_version.load();
+  report.times.total = ms_since(t0);
+  {
+    std::lock_guard lock(s.state_mutex);
+    s.trajectory.push_back({frame.timestamp, report.T_wc.cast<double>()});
+    s.reports.push_back(report);
+    s.state = report.state;
+    s.tracker_keyframes = s.tracker.keyframes().size();
+  }
+  return report;
+}
+
+void Session::flush() { impl_->worker.wait(); }
+
+void Session::finish() {
+  Impl& s = *impl_;
+  s.worker.wait();
+  if (!s.pending.empty() || s.config.final_steps > 0) {
+    FrameReport dummy;
+    if (!s.pending.empty()) s.schedule_mapping(dummy);
+    s.worker.wait();
+    for (int i = 0; i < s.config.final_steps; ++i) {
+      s.schedule_mapping(dummy);
+      s.worker.wait();
+    }
+  }
+}
+
+}  // namespace rrg

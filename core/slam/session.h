@@ -1,0 +1,147 @@
+#pragma once
+// One online reconstruction session (paper §4, DESIGN.md §1): the hybrid map (augmented TSDF, base
+// and reflection Gaussians, global plane table, keyframes) and the paper's schedule:
+//   every frame        pre-mapping on the caller's thread: preprocess -> track (ICP -> masked ORB)
+//                      -> fuse the TSDF;
+//   every N_p frames   plane identification (segmentation -> global table -> semantic cue ->
+//                      variance check -> 5-window vote) and fusion of the reflection attributes;
+//   every N_o frames   a Gaussian mapping step (densify -> 30 iterations -> prune) on the mapping
+//                      thread, overlapping the next frames' pre-mapping (SessionConfig::sync = false),
+//                      or inline at the same frame positions (sync = true: deterministic).
+// process() is called by one thread (the session's worker); every const query below may be called
+// from any thread at the same time (renders use the last published Gaussian snapshot and take the
+// volume lock only for the raycast).
+#include "core/common/camera.h"
+#include "core/common/image.h"
+#include "core/common/mesh.h"
+#include "core/gaussians/gaussian_set.h"
+#include "core/gaussians/reflective_plane.h"
+#include "core/io/trajectory.h"
+#include "core/slam/session_config.h"
+#include "core/tracking/tracker.h"
+
+#include <Eigen/Geometry>
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace rrg {
+
+class SemanticCue;
+
+// One RGB-D frame as the session takes it (host images of the session's size, registered).
+struct SessionFrame {
+  int64_t index = 0;                         // strictly increasing within a session
+  double timestamp = 0;                      // seconds
+  ColorImage color;                          // C_k, RGB in [0, 1]
+  DepthImage depth;                          // D_k, metres, 0 = invalid
+  std::optional<LabelImage> labels;          // per-pixel semantic categories (the labels cue)
+  std::optional<Eigen::Isometry3f> pose;     // a pose prior, or the pose itself with config.gt_poses
+};
+
+// Milliseconds of one frame's stages (0 where a stage did not run).
+struct StageTimes {
+  double decode = 0;       // filled by callers that decode (the service)
+  double raycast = 0;      // model raycast at T_{k-1} for ICP
+  double preprocess = 0;
+  double icp = 0;
+  double orb = 0;          // ORB + motion-only BA (+ the tracking-mask render)
+  double fuse = 0;
+  double identify = 0;     // plane identification incl. its C_var raycast
+  double mapping = 0;      // a mapping step run inline (sync) or waited for
+  double total = 0;        // the whole process() call
+};
+
+struct FrameReport {
+  int64_t index = 0;
+  double timestamp = 0;
+  Eigen::Isometry3f T_wc = Eigen::Isometry3f::Identity();
+  TrackingState state = TrackingState::Ok;
+  bool fused = false;              // false when lost (the frame is not fused)
+  bool identified = false;         // plane identification ran on this frame
+  bool mapping_started = false;    // a mapping step was started (async) or run (sync) after it
+  uint64_t map_version = 0;        // after this frame
+  std::string note;                // tracking note
+  StageTimes times;
+};
+
+// The images of one render (host, the camera's size).
+struct SessionView {
+  ColorImage C;      // final colour C = C_b + R C_r
+  ColorImage C_b;    // base (TSDF + base Gaussians)
+  ColorImage C_r;    // reflection Gaussians' colour
+  ColorImage RC_r;   // R * C_r
+  MaskImage R;       // reflection mask (0 / 1)
+  DepthImage depth;  // D_b, metres
+};
+
+// Statistics of one mapping step, and their sums over a session.
+struct MappingSummary {
+  int64_t steps = 0;
+  int64_t base_gaussians = 0, reflection_gaussians = 0;
+  double ms_total = 0;             // summed over steps
+  double last_loss = 0;
+};
+
+struct SessionStatus {
+  int64_t frames = 0;              // processed
+  int64_t fused = 0;               // fused into the map
+  int64_t lost = 0;
+  int64_t last_index = -1;
+  TrackingState state = TrackingState::Ok;
+  Eigen::Isometry3f T_wc = Eigen::Isometry3f::Identity();  // last pose
+  uint64_t map_version = 0;        // bumps on every fusion and mapping step
+  int64_t tsdf_blocks = 0;
+  int64_t keyframes = 0;
+  int64_t global_planes = 0;
+  std::vector<int> reflective_planes;  // accepted (L_ref), canonical ids
+  MappingSummary mapping;
+  size_t device_bytes = 0, host_bytes = 0;
+};
+
+class Session {
+ public:
+  // Throws std::invalid_argument for a bad config (naming the field). `cue` overrides the cue the
+  // config names (tests, in-process segmenters).
+  explicit Session(SessionConfig config, std::unique_ptr<SemanticCue> cue = nullptr);
+  ~Session();  // stops the mapping thread (an unfinished step is completed first)
+  Session(const Session&) = delete;
+  Session& operator=(const Session&) = delete;
+
+  const SessionConfig& config() const;
+
+  // Pre-mapping of one frame, on the calling thread; schedules identification and mapping.
+  // Throws std::invalid_argument for a frame of the wrong size or an index not above the last
+  // one; the session is unchanged then.
+  FrameReport process(const SessionFrame& frame);
+  // Waits for a running mapping step (async mode). process() and queries stay usable.
+  void flush();
+  // End of a sequence: flush, then run config.final_steps further mapping steps over the keyframes.
+  void finish();
+
+  // Thread-safe queries.
+  SessionView render(const Intrinsics& K, const Eigen::Isometry3f& T_wc) const;
+  TriangleMesh mesh(uint64_t changed_since = 0) const;   // marching cubes (of blocks changed since)
+  GaussianHost base_gaussians() const;
+  GaussianHost reflection_gaussians() const;
+  std::vector<ReflectivePlane> reflective_planes() const;  // accepted planes with equations
+  io::Trajectory trajectory() const;                     // one pose per processed frame
+  std::vector<FrameReport> reports() const;              // one per processed frame
+  SessionStatus status() const;
+
+  // Snapshots: versioned, checksummed, written atomically (a failed save leaves the old file).
+  // load() rebuilds a session that continues where the saved one stopped.
+  void save(const std::filesystem::path& file) const;
+  static std::unique_ptr<Session> load(const std::filesystem::path& file,
+                                       std::unique_ptr<SemanticCue> cue = nullptr);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rrg

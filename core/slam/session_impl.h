@@ -1,0 +1,104 @@
+#pragma once
+// Session internals shared by session.cpp (the schedule), session_queries.cpp (thread-safe
+// renders, meshes, status) and session_snapshot.cpp (save / load). Not part of the API.
+//
+// Locks, always taken in this order when nested:
+//   volume_mutex   the TSDF: fusion (process thread), raycasts of tracking, identification,
+//                  mapping (mapping thread) and renders (any thread);
+//   state_mutex    trajectory, reports, status fields, reflective planes.
+// The mapper publishes immutable snapshots for renders (core/slam/mapper.h), so rendering never
+// waits for a mapping step.
+#include "core/planes/plane_identification.h"
+#include "core/slam/mapper.h"
+#include "core/slam/session.h"
+#include "core/tracking/mask_source.h"
+#include "core/tracking/model_source.h"
+#include "core/tsdf/tsdf_raycast.h"
+#include "core/tsdf/tsdf_volume.h"
+
+#include <atomic>
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+
+namespace rrg {
+
+// ICP's model source with the raycast taken under the volume lock.
+class LockedModelSource final : public ModelSource {
+ public:
+  LockedModelSource(const TsdfVolume& volume, const Intrinsics& K, std::mutex& m) : inner_(volume, K), mutex_(m) {}
+  IcpModel model_at(const Eigen::Isometry3f& T_wc) override {
+    std::lock_guard lock(mutex_);
+    return inner_.model_at(T_wc);
+  }
+  void invalidate() { inner_.invalidate(); }
+
+ private:
+  TsdfModelSource inner_;
+  std::mutex& mutex_;
+};
+
+// The mapping thread: runs one step at a time when asked; wait() blocks until it is idle.
+class MappingWorker {
+ public:
+  MappingWorker() = default;
+  ~MappingWorker() { stop(); }
+  void start(std::function<void()> job);  // starts the thread on first use; job runs on it
+  void wait();                            // until the current job (if any) finished
+  void stop();
+  bool busy() const;
+
+ private:
+  void loop();
+  std::thread thread_;
+  mutable std::mutex m_;
+  std::condition_variable cv_;
+  std::function<void()> job_;
+  bool running_ = false, quit_ = false;
+  std::exception_ptr error_;
+};
+
+struct Session::Impl {
+  explicit Impl(SessionConfig c, std::unique_ptr<SemanticCue> cue);
+
+  // process() stages
+  void identify(const SessionFrame& frame, const Eigen::Isometry3f& T_wc, FrameReport& report,
+                DeviceImage<int32_t>& plane_ids, DeviceImage<uint8_t>& mask);
+  void schedule_mapping(FrameReport& report);
+  MappingContext mapping_context();
+  RaycastResult locked_raycast(const Intrinsics& K, const Eigen::Isometry3f& T_wc) const;
+  ColorImage render_reflection(const Eigen::Isometry3f& T_wc);  // C_r for the tracking mask
+  std::vector<int32_t> remap_copy() const {
+    std::lock_guard lock(state_mutex);
+    return remap;
+  }
+
+  SessionConfig config;
+  Intrinsics K;
+  mutable std::mutex volume_mutex;
+  TsdfVolume volume;
+  LockedModelSource model;
+  Tracker tracker;
+  PlaneIdentifier identifier;
+  GaussianMapper mapper;
+  std::unique_ptr<MaskSource> masks;  // icp+orb+mask: rendered C_r
+  MappingWorker worker;
+
+  // the schedule
+  int64_t frames = 0, fused = 0, lost = 0, last_index = -1;
+  std::vector<MappingFrame> pending;  // fused frames not yet handed to the mapper
+  std::vector<bool> pending_keyframe;
+
+  mutable std::mutex state_mutex;
+  std::vector<int32_t> remap;          // plane id -> canonical id (identification)
+  size_t tracker_keyframes = 0, global_planes = 0;
+  io::Trajectory trajectory;
+  std::vector<FrameReport> reports;
+  std::vector<ReflectivePlane> reflective;
+  MappingSummary mapping;
+  std::atomic<uint64_t> map_version{0};
+  TrackingState state = TrackingState::Ok;
+  Eigen::Isometry3f T_last = Eigen::Isometry3f::Identity();
+};
+
+}  // namespace rrg

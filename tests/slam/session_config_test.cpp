@@ -1,0 +1,109 @@
+// SessionConfig: the field table, overrides, YAML files and their round trip.
+#include "core/slam/session_config.h"
+#include "tests/support/test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+namespace rrg {
+namespace {
+
+SessionConfig camera_config() {
+  SessionConfig c;
+  c.K = {200.f, 200.f, 79.5f, 59.5f, 160, 120};
+  return c;
+}
+
+TEST(SessionConfig, DefaultsAreThePapers) {
+  SessionConfig c = camera_config();
+  EXPECT_NO_THROW(c.validate());
+  EXPECT_EQ(c.plane_period, 10);    // N_p
+  EXPECT_EQ(c.mapping_period, 10);  // N_o
+  EXPECT_FLOAT_EQ(c.tsdf.voxel_size, 0.005f);
+  EXPECT_FLOAT_EQ(c.planes.variance_threshold, 0.01f);  // δ_v
+  EXPECT_EQ(c.mapping.iterations, 30);
+  EXPECT_EQ(c.mapping.n_local, 2);
+  EXPECT_EQ(c.mapping.n_global, 7);
+}
+
+TEST(SessionConfig, BadIntrinsicsNameTheField) {
+  SessionConfig c;
+  try {
+    c.validate();
+    FAIL() << "no throw";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("intrinsics"), std::string::npos) << e.what();
+  }
+  c = camera_config();
+  c.K.cx = 1e6f;
+  EXPECT_THROW(c.validate(), std::invalid_argument);
+  c = camera_config();
+  c.K.width = 100000;
+  EXPECT_THROW(c.validate(), std::invalid_argument);
+}
+
+TEST(SessionConfig, OverridesSetFieldsAndRejectNonsense) {
+  SessionConfig c = camera_config();
+  apply_override(c, "tsdf.voxel_size=0.01");
+  apply_override(c, "tracking.mode=icp");
+  apply_override(c, "sync=true");
+  apply_override(c, "mapping_period = 5");
+  EXPECT_FLOAT_EQ(c.tsdf.voxel_size, 0.01f);
+  EXPECT_EQ(c.tracking.mode, TrackingMode::Icp);
+  EXPECT_TRUE(c.sync);
+  EXPECT_EQ(c.mapping_period, 5);
+  try {
+    apply_override(c, "tsdf.voxelsize=0.01");
+    FAIL() << "no throw";
+  } catch (const std::invalid_argument& e) {  // suggests the real key
+    EXPECT_NE(std::string(e.what()).find("tsdf.voxel_size"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(apply_override(c, "tsdf.voxel_size=abc"), std::invalid_argument);
+  EXPECT_THROW(apply_override(c, "tsdf.voxel_size=nan"), std::invalid_argument);
+  EXPECT_THROW(apply_override(c, "mapping_period=2.5"), std::invalid_argument);
+  EXPECT_THROW(apply_override(c, "sync=maybe"), std::invalid_argument);
+  EXPECT_THROW(apply_override(c, "no_equals_sign"), std::invalid_argument);
+  EXPECT_THROW(apply_override(c, "tracking.mode=orb"), std::invalid_argument);
+  EXPECT_FLOAT_EQ(c.tsdf.voxel_size, 0.01f);  // failed overrides change nothing
+}
+
+TEST(SessionConfig, YamlFilesAreNestedAndRoundTrip) {
+  test::TempDir dir("config");
+  {
+    std::ofstream f(dir / "a.yaml");
+    f << "tsdf:\n  voxel_size: 0.02\n  truncation: 0.08\nplanes:\n  vote:\n    windows: 7\nprompts: [floor, tv]\n";
+  }
+  SessionConfig c = camera_config();
+  load_config_yaml(c, dir / "a.yaml");
+  EXPECT_FLOAT_EQ(c.tsdf.voxel_size, 0.02f);
+  EXPECT_FLOAT_EQ(c.tsdf.truncation, 0.08f);
+  EXPECT_EQ(c.planes.vote.windows, 7);
+  ASSERT_EQ(c.prompts.size(), 2u);
+  EXPECT_EQ(c.prompts[1], "tv");
+
+  // every field survives config_to_yaml -> load_config_yaml
+  c.mapping.reflections = false;
+  c.semantics = "none";
+  {
+    std::ofstream(dir / "b.yaml") << config_to_yaml(c);
+  }
+  SessionConfig d;
+  load_config_yaml(d, dir / "b.yaml");
+  auto fc = config_fields(c), fd = config_fields(d);
+  ASSERT_EQ(fc.size(), fd.size());
+  for (size_t i = 0; i < fc.size(); ++i) EXPECT_EQ(fc[i].get(), fd[i].get()) << fc[i].name;
+
+  {
+    std::ofstream(dir / "bad.yaml") << "tsdf:\n  voxel_sise: 0.02\n";
+  }
+  EXPECT_THROW(load_config_yaml(c, dir / "bad.yaml"), std::runtime_error);
+  {
+    std::ofstream(dir / "broken.yaml") << "tsdf: [unclosed\n";
+  }
+  EXPECT_THROW(load_config_yaml(c, dir / "broken.yaml"), std::runtime_error);
+  EXPECT_THROW(load_config_yaml(c, dir / "missing.yaml"), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace rrg

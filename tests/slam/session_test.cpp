@@ -1,0 +1,194 @@
+// Session: the schedule on a small synthetic reflective sequence (real tracking, fusion, plane
+// identification and mapping on the CPU), determinism of --sync, bad input, snapshots.
+#include "core/eval/trajectory_metrics.h"
+#include "core/io/dataset.h"
+#include "core/io/synth_layout.h"
+#include "core/planes/semantic_labels.h"
+#include "core/slam/session.h"
+#include "tests/support/test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <fstream>
+#include <thread>
+
+namespace rrg {
+namespace {
+
+class SessionTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new test::TempDir("session");
+    const auto r = test::run_rrg("synth --preset mirror_room --frames 24 --width 160 --height 120 --novel 2 --noise --out " +
+                                 (dir_->path() / "seq").string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  static void TearDownTestSuite() {
+    delete dir_;
+    dir_ = nullptr;
+  }
+  static std::filesystem::path root() { return dir_->path() / "seq"; }
+
+  static SessionConfig config(const io::Dataset& d) {
+    SessionConfig c;
+    c.K = d.intrinsics();
+    c.tsdf.voxel_size = 0.02f;  // a coarse map keeps the CPU test fast
+    c.tsdf.truncation = 0.08f;
+    c.tracking.mode = TrackingMode::Icp;
+    c.semantics = "labels";
+    for (const auto& [id, name] : read_category_table(io::synth_scene_file(root(), "categories.json")).names)
+      c.categories[id] = name;
+    c.sync = true;
+    c.mapping.iterations = 5;
+    return c;
+  }
+  static SessionFrame frame(const io::Dataset& d, size_t i, bool with_pose) {
+    io::Frame f = d.load(i);
+    SessionFrame s;
+    s.index = int64_t(i);
+    s.timestamp = f.timestamp;
+    s.color = std::move(f.color);
+    s.depth = std::move(f.depth);
+    s.labels = io::read_synth_labels(root(), i);
+    if (with_pose) s.pose = f.T_wc_gt->cast<float>();
+    return s;
+  }
+  static void run(Session& s, const io::Dataset& d, size_t n, bool poses_always) {
+    for (size_t i = 0; i < n; ++i) s.process(frame(d, i, poses_always || i == 0));
+  }
+  static test::TempDir* dir_;
+};
+test::TempDir* SessionTest::dir_ = nullptr;
+
+TEST_F(SessionTest, GroundTruthPosesMapAndRender) {
+  const auto d = io::open_dataset(root());
+  SessionConfig c = config(*d);
+  c.gt_poses = true;
+  Session s(c);
+  run(s, *d, 20, true);
+  s.finish();
+  const SessionStatus st = s.status();
+  EXPECT_EQ(st.frames, 20);
+  EXPECT_EQ(st.fused, 20);
+  EXPECT_GE(st.mapping.steps, 2);
+  EXPECT_GT(st.mapping.base_gaussians, 0);
+  EXPECT_GT(st.tsdf_blocks, 0);
+  const auto traj = s.trajectory();
+  ASSERT_EQ(traj.size(), 20u);
+  const auto gt = d->ground_truth();
+  for (size_t i = 0; i < traj.size(); ++i)
+    EXPECT_LT((traj[i].T_wc.translation() - gt[i].T_wc.translation()).norm(), 1e-6);
+  const SessionView v = s.render(c.K, d->load(5).T_wc_gt->cast<float>());
+  ASSERT_EQ(v.C.width(), c.K.width);
+  double sum = 0;
+  for (const Color& px : v.C.pixels()) sum += px.sum();
+  EXPECT_GT(sum, 0.0) << "the render is black";
+  EXPECT_GT(s.mesh().triangles.size(), 100u);
+}
+
+TEST_F(SessionTest, TracksTheSequence) {
+  const auto d = io::open_dataset(root());
+  Session s(config(*d));
+  run(s, *d, 24, false);
+  s.finish();
+  io::Trajectory gt = d->ground_truth();
+  gt.resize(24);
+  const auto m = eval::evaluate_trajectory(s.trajectory(), gt);
+  EXPECT_LT(m.ate.rmse_cm, 2.0) << "ATE " << m.ate.rmse_cm << " cm";
+  EXPECT_EQ(s.status().lost, 0);
+}
+
+TEST_F(SessionTest, SyncModeIsDeterministic) {
+  const auto d = io::open_dataset(root());
+  Session a(config(*d)), b(config(*d));
+  run(a, *d, 21, false);
+  run(b, *d, 21, false);
+  const auto ta = a.trajectory(), tb = b.trajectory();
+  ASSERT_EQ(ta.size(), tb.size());
+  for (size_t i = 0; i < ta.size(); ++i) EXPECT_TRUE(ta[i].T_wc.isApprox(tb[i].T_wc, 0.0)) << "frame " << i;
+  const GaussianHost ga = a.base_gaussians(), gb = b.base_gaussians();
+  ASSERT_EQ(ga.size(), gb.size());
+  for (size_t i = 0; i < ga.size(); ++i) ASSERT_EQ(ga.means[i], gb.means[i]) << "Gaussian " << i;
+  EXPECT_EQ(a.mesh().triangles.size(), b.mesh().triangles.size());
+}
+
+TEST_F(SessionTest, BadFramesAreRejectedAndTheSessionGoesOn) {
+  const auto d = io::open_dataset(root());
+  Session s(config(*d));
+  s.process(frame(*d, 0, true));
+  SessionFrame small = frame(*d, 1, false);
+  small.depth = DepthImage(80, 60, 1.0f);
+  EXPECT_THROW(s.process(small), std::invalid_argument);
+  SessionFrame old = frame(*d, 1, false);
+  old.index = 0;  // not above the last id
+  EXPECT_THROW(s.process(old), std::invalid_argument);
+  EXPECT_EQ(s.status().frames, 1);
+  const FrameReport r = s.process(frame(*d, 1, false));
+  EXPECT_NE(r.state, TrackingState::Lost);
+  EXPECT_EQ(s.status().frames, 2);
+}
+
+TEST_F(SessionTest, RendersWhileMappingRuns) {
+  const auto d = io::open_dataset(root());
+  SessionConfig c = config(*d);
+  c.sync = false;  // mapping on its own thread
+  Session s(c);
+  std::atomic<bool> done{false};
+  std::atomic<int> renders{0};
+  const Eigen::Isometry3f T = d->load(0).T_wc_gt->cast<float>();
+  std::thread viewer([&] {
+    while (!done) {
+      const SessionView v = s.render(c.K, T);
+      EXPECT_EQ(v.C.width(), c.K.width);
+      ++renders;
+    }
+  });
+  run(s, *d, 24, false);
+  s.finish();
+  done = true;
+  viewer.join();
+  EXPECT_GT(renders.load(), 0);
+  EXPECT_GE(s.status().mapping.steps, 2);
+}
+
+TEST_F(SessionTest, SnapshotRestoresTheMapAndContinues) {
+  const auto d = io::open_dataset(root());
+  test::TempDir dir("snap");
+  Session s(config(*d));
+  run(s, *d, 20, false);
+  s.flush();
+  s.save(dir / "s.rrgs");
+  const auto loaded = Session::load(dir / "s.rrgs");
+  EXPECT_EQ(loaded->mesh().triangles.size(), s.mesh().triangles.size());
+  const GaussianHost a = s.base_gaussians(), b = loaded->base_gaussians();
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a.means[i], b.means[i]);
+  EXPECT_EQ(loaded->reflection_gaussians().size(), s.reflection_gaussians().size());
+  EXPECT_EQ(loaded->status().frames, 20);
+  EXPECT_EQ(loaded->status().global_planes, s.status().global_planes);
+  const auto ta = s.trajectory(), tb = loaded->trajectory();
+  ASSERT_EQ(ta.size(), tb.size());
+  EXPECT_TRUE(ta.back().T_wc.isApprox(tb.back().T_wc, 1e-6));
+  // both continue the same way from the restored state
+  const FrameReport ra = s.process(frame(*d, 20, false));
+  const FrameReport rb = loaded->process(frame(*d, 20, false));
+  EXPECT_NE(rb.state, TrackingState::Lost);
+  EXPECT_LT((ra.T_wc.translation() - rb.T_wc.translation()).norm(), 1e-3);
+
+  // corrupt and truncated snapshots are refused with a message
+  std::vector<char> bytes;
+  {
+    std::ifstream f(dir / "s.rrgs", std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+  }
+  bytes[bytes.size() / 2] ^= 0x55;
+  std::ofstream(dir / "bad.rrgs", std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+  EXPECT_THROW(Session::load(dir / "bad.rrgs"), std::runtime_error);
+  std::ofstream(dir / "short.rrgs", std::ios::binary).write(bytes.data(), std::streamsize(bytes.size() / 3));
+  EXPECT_THROW(Session::load(dir / "short.rrgs"), std::runtime_error);
+  EXPECT_THROW(Session::load(dir / "missing.rrgs"), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace rrg
