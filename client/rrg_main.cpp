@@ -24,6 +24,10 @@ int main(int argc, char** argv) {
   rrg::cli::register_fuse_command(app);
   rrg::cli::register_track_command(app);
   rrg::cli::register_planes_command(app);
+  rrg::cli::register_serve_command(app);
+  rrg::cli::register_stream_command(app);
+  rrg::cli::register_fetch_commands(app);
+  rrg::cli::register_session_commands(app);
   rrg::cli::register_run_command(app);
 
   try {

@@ -16,6 +16,11 @@ void register_device_command(CLI::App& app);   // rrg devices
 void register_fuse_command(CLI::App& app);     // rrg fuse (TSDF from a posed dataset -> mesh)
 void register_track_command(CLI::App& app);    // rrg track (tracking + TSDF fusion on a dataset)
 void register_planes_command(CLI::App& app);   // rrg planes (reflective plane identification)
+// The service (issue #9; without gRPC these say the build has none):
+void register_serve_command(CLI::App& app);     // rrg serve
+void register_stream_command(CLI::App& app);    // rrg stream
+void register_fetch_commands(CLI::App& app);    // rrg render | mesh | gaussians
+void register_session_commands(CLI::App& app);  // rrg sessions | save | load
 void register_run_command(CLI::App& app);      // rrg run (the whole pipeline on a dataset, with evaluation)
 
 }  // namespace rrg::cli

@@ -1,0 +1,64 @@
+// rrg serve: the gRPC reconstruction service (server/, docs/service.md).
+#include "client/commands/command.h"
+
+#if RRG_WITH_GRPC
+#include "core/common/device.h"
+#include "server/server.h"
+
+#include <spdlog/spdlog.h>
+
+#include <cstdlib>
+#include <memory>
+
+namespace rrg::cli {
+
+void register_serve_command(CLI::App& app) {
+  auto* cmd = app.add_subcommand("serve", "run the gRPC reconstruction service (docs/service.md)");
+  auto o = std::make_shared<server::ServerOptions>();
+  auto device = std::make_shared<std::string>("auto");
+  auto max_message_mb = std::make_shared<double>(64);
+  auto session_mb = std::make_shared<double>(0), total_mb = std::make_shared<double>(0);
+  auto log_json = std::make_shared<bool>(false);
+  auto max_sessions = std::make_shared<size_t>(16), queue = std::make_shared<size_t>(8);
+  cmd->add_option("--address", o->address, "listen address HOST:PORT (port 0: any free port)")->capture_default_str();
+  cmd->add_option("--port-file", o->port_file, "write the bound port to this file once serving");
+  cmd->add_option("--device", *device, "cpu | cuda | cuda:N | auto: where sessions run")->capture_default_str();
+  cmd->add_option("--max-sessions", *max_sessions, "admission: live sessions at most")->capture_default_str();
+  cmd->add_option("--session-memory-mb", *session_mb, "admission: memory budget per session, MiB (0 = none)");
+  cmd->add_option("--total-memory-mb", *total_mb, "admission: memory budget of all sessions, MiB (0 = none)");
+  cmd->add_option("--queue", *queue, "default frame queue capacity per session")->capture_default_str();
+  cmd->add_option("--snapshot-dir", o->manager.snapshot_dir, "folder for Save / Load / idle and shutdown snapshots");
+  cmd->add_option("--idle-timeout", o->manager.idle_timeout_s, "seconds without calls before a session is snapshotted and freed (0 = never)");
+  cmd->add_option("--admin-key", o->manager.admin_key, "admin bearer key for List / Load (default: $RRG_ADMIN_KEY)");
+  cmd->add_option("--segmenter", o->manager.segmenter_address, "rrg.v1.Segmenter address for semantics = remote");
+  cmd->add_option("--tls-cert", o->tls_cert, "PEM certificate chain: serve TLS");
+  cmd->add_option("--tls-key", o->tls_key, "PEM private key for --tls-cert");
+  cmd->add_option("--max-message-mb", *max_message_mb, "largest message accepted or sent, MiB")->capture_default_str();
+  cmd->add_option("--metrics-port", o->metrics_port, "Prometheus text endpoint port (-1 = off, 0 = any)")->capture_default_str();
+  cmd->add_option("--shutdown-grace", o->shutdown_grace_s, "seconds in-flight calls get at shutdown")->capture_default_str();
+  cmd->add_flag("--log-json", *log_json, "one JSON object per log line (time, level, message)");
+  cmd->callback([=] {
+    if (*log_json) spdlog::set_pattern(R"({"time":"%Y-%m-%dT%H:%M:%S.%f%z","level":"%l","thread":%t,"msg":"%v"})");
+    server::ServerOptions opts = *o;
+    opts.manager.device = parse_device(*device);
+    opts.manager.max_sessions = *max_sessions;
+    opts.manager.default_queue = *queue;
+    opts.manager.session_memory_budget = size_t(*session_mb * 1024.0 * 1024.0);
+    opts.manager.total_memory_budget = size_t(*total_mb * 1024.0 * 1024.0);
+    opts.max_message_bytes = int(*max_message_mb * 1024.0 * 1024.0);
+    if (opts.manager.admin_key.empty())
+      if (const char* env = std::getenv("RRG_ADMIN_KEY")) opts.manager.admin_key = env;
+    server::run_server(opts);
+  });
+}
+
+}  // namespace rrg::cli
+#else
+namespace rrg::cli {
+void register_serve_command(CLI::App& app) {
+  app.add_subcommand("serve", "run the gRPC reconstruction service (not in this build)")->callback([] {
+    throw std::runtime_error("serve: this build has no gRPC (install libgrpc++-dev protobuf-compiler-grpc, rebuild)");
+  });
+}
+}  // namespace rrg::cli
+#endif

@@ -1,0 +1,84 @@
+#pragma once
+// The server's sessions: creation with admission control (max sessions, per-session and total
+// memory budgets -> RESOURCE_EXHAUSTED with the reason), lookup with bearer-token auth, Close,
+// Save / Load to the snapshot folder (Session::save plus a JSON sidecar of the service's own
+// metadata, both written atomically), the idle timeout (snapshot, then free) and the final
+// snapshot of every session at shutdown.
+#include "core/common/device.h"
+#include "rrg/v1/service.pb.h"
+#include "server/managed_session.h"
+#include "server/metrics.h"
+
+#include <grpcpp/server_context.h>
+
+#include <condition_variable>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace rrg::server {
+
+struct ManagerOptions {
+  size_t max_sessions = 16;
+  size_t session_memory_budget = 0;  // bytes per session (device + host); 0 = none
+  size_t total_memory_budget = 0;    // bytes over all sessions; 0 = none
+  size_t default_queue = 8;          // frame queue capacity when Create asks for 0
+  size_t max_queue = 256;
+  std::filesystem::path snapshot_dir;  // empty = Save / Load / idle snapshots unavailable
+  double idle_timeout_s = 0;         // 0 = never
+  Device device;                     // where sessions run
+  std::string admin_key;             // empty = no admin key
+  std::string segmenter_address;     // for sessions whose config asks for semantics = remote
+};
+
+class SessionManager {
+ public:
+  SessionManager(ManagerOptions options, Metrics& metrics);
+  ~SessionManager();  // stops the idle reaper; sessions are freed without snapshots (see shutdown)
+
+  v1::CreateSessionResponse create(const v1::CreateSessionRequest& request);
+  // The session `id` (or the x-rrg-session header when id is empty) if the call's bearer token is
+  // its token or the admin key. NOT_FOUND / UNAUTHENTICATED / INVALID_ARGUMENT (no id) otherwise.
+  std::shared_ptr<ManagedSession> authorize(const grpc::ServerContextBase& ctx, const std::string& id) const;
+  // UNAUTHENTICATED unless the call carries the admin key (a no-op when none is configured).
+  void require_admin(const grpc::ServerContextBase& ctx) const;
+
+  std::vector<std::shared_ptr<ManagedSession>> list() const;
+  v1::CloseSessionResponse close(const std::string& id, bool save);
+  v1::SaveSessionResponse save(ManagedSession& s);
+  // Auth: the admin key, or the token the session had when saved (which is then kept).
+  v1::CreateSessionResponse load(const grpc::ServerContextBase& ctx, const std::string& id);
+
+  size_t size() const;
+  bool has_capacity() const;   // a Create would pass the session-count and memory checks now
+  std::string gauges() const;  // Prometheus lines: sessions, memory, queues
+  // Snapshots (when a snapshot folder is set) and frees every session; queued frames are processed.
+  void shutdown();
+  const ManagerOptions& options() const { return options_; }
+
+ private:
+  std::shared_ptr<ManagedSession> find(const std::string& id) const;
+  void admit(size_t extra_sessions) const;  // throws RESOURCE_EXHAUSTED; caller holds mutex_
+  size_t used_bytes() const;                // caller holds mutex_
+  std::filesystem::path snapshot_file(const std::string& id) const;
+  std::filesystem::path meta_file(const std::string& id) const;
+  void write_meta(const ManagedSession& s) const;
+  void reap_idle();
+
+  ManagerOptions options_;
+  Metrics& metrics_;
+  mutable std::mutex mutex_;
+  std::map<std::string, std::shared_ptr<ManagedSession>> sessions_;
+  size_t pending_ = 0;  // admitted, being constructed
+
+  std::mutex reaper_mutex_;
+  std::condition_variable reaper_cv_;
+  bool reaper_quit_ = false;
+  std::thread reaper_;
+};
+
+}  // namespace rrg::server
