@@ -31,7 +31,7 @@ struct TrackOptions {
   io::DatasetFlags flags;
   float voxel = 0.01f, trunc = 0.0f, max_depth = 5.0f;
   int max_frames = 0, progress = 50;
-  bool no_bilateral = false, identity_start = false;
+  bool no_bilateral = false, identity_start = false, fuse_raw = false;
   float icp_prior = TrackingParams{}.orb.icp_prior_scale;
 };
 
@@ -95,7 +95,9 @@ void run_track(const TrackOptions& o) {
     double ms_fuse = 0;
     if (r.state != TrackingState::Lost) {
       t0 = Clock::now();
-      integrate(volume, depth, color, K, r.T_wc);
+      // The preprocessed D_k (bilateral filter) unless asked otherwise: see Tracker::preprocessed_depth().
+      const DeviceImage<float>* fused = o.fuse_raw ? &depth : tracker.preprocessed_depth();
+      integrate(volume, fused ? *fused : depth, color, K, r.T_wc);
       model.invalidate();
       ms_fuse = ms_since(t0);
     }
@@ -180,6 +182,8 @@ void register_track_command(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--no-bilateral", opts->no_bilateral, "skip the bilateral depth filter");
+  cmd->add_flag("--fuse-raw-depth", opts->fuse_raw,
+                "fuse the raw depth instead of the preprocessed (bilateral-filtered) one (ablation)");
   cmd->add_flag("--identity-start", opts->identity_start, "start at the identity instead of the first ground-truth pose");
   io::add_dataset_flags(*cmd, opts->flags);
   cmd->callback([opts] { run_track(*opts); });

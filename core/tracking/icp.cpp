@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 
 namespace rrg {
@@ -64,10 +65,15 @@ IcpResult icp_align(const FramePyramid& frame, const IcpModel& model, const Eige
   IcpResult result;
   Eigen::Isometry3d T = T_wc_init.cast<double>();
   const int top = std::min<int>(int(frame.levels.size()), 3) - 1;
+  // The last level-0 system and whether it is still valid at the final pose: when the last step
+  // was rejected (no update) or below the convergence thresholds (< 0.1 mm), it serves as the
+  // quality measure instead of one more full reduction.
+  std::optional<kernel::IcpSystem> last;
   for (int l = top; l >= 0; --l) {
     const VertexNormalMaps& maps = frame.levels[size_t(l)].maps;
     for (int it = 0; it < params.iterations[l]; ++it) {
       const kernel::IcpSystem s = reduce_icp_system(maps, model, T.cast<float>(), params);
+      if (l == 0) last = s;
       Eigen::Matrix<double, 6, 1> xi;
       if (!solve_icp_step(s, xi)) break;
       T = orthonormalized(se3_exp(xi) * T);
@@ -76,10 +82,11 @@ IcpResult icp_align(const FramePyramid& frame, const IcpModel& model, const Eige
                          xi.tail<3>().norm() < params.converge_rotation_rad;
       if (l == 0) result.converged = small;
       if (small) break;
+      if (l == 0) last.reset();  // T moved by more than the thresholds
     }
   }
   // Quality at the final pose, level 0.
-  const kernel::IcpSystem s = reduce_icp_system(frame.levels[0].maps, model, T.cast<float>(), params);
+  const kernel::IcpSystem s = last ? *last : reduce_icp_system(frame.levels[0].maps, model, T.cast<float>(), params);
   result.T_wc = T.cast<float>();
   result.inliers = int64_t(s.inliers);
   result.valid = int64_t(s.valid);

@@ -3,6 +3,6 @@
 
 namespace rrg::kernel {
 
-IcpSystem reduce_icp_cpu(const IcpArgs& a) { return reduce_icp(CpuBackend{}, a); }
+IcpSystem reduce_icp_cpu(const IcpArgs& a) { return reduce_icp_tasks(CpuBackend{}, a); }
 
 }  // namespace rrg::kernel

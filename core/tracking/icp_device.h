@@ -54,38 +54,83 @@ struct IcpArgs {
   float max_distance, min_cos, huber_delta;
 };
 
+// Rounded single-precision multiply and add that the compiler may not fuse into an FMA. The
+// association chain below (two rigid transforms and the projection) is written with them in a
+// fixed order, so the host (x86-64 without FMA contraction) and CUDA (which contracts a*b+c into
+// fma by default) compute bit-identical û: a pixel projecting within an ulp of a half-pixel
+// position must pick the same model pixel on every back end. This matters at pyramid levels
+// l >= 1, whose pixel centres map exactly onto half-pixel positions of the full-resolution model
+// (c_l = (c + 0.5) / 2^l - 0.5), so small motions put many û next to a rounding tie.
+RRG_HD inline float mul_rn(float a, float b) {
+#if defined(__CUDA_ARCH__)
+  return __fmul_rn(a, b);
+#else
+  return a * b;
+#endif
+}
+RRG_HD inline float add_rn(float a, float b) {
+#if defined(__CUDA_ARCH__)
+  return __fadd_rn(a, b);
+#else
+  return a + b;
+#endif
+}
+
+// R x + t, each row summed left to right with rounded products: ((R0 x0 + R1 x1) + R2 x2) + t.
+RRG_HD inline Eigen::Vector3f rigid_rn(const Eigen::Matrix3f& R, const Eigen::Vector3f& t, const Eigen::Vector3f& x) {
+  Eigen::Vector3f out;
+  for (int r = 0; r < 3; ++r)
+    out[r] = add_rn(add_rn(add_rn(mul_rn(R(r, 0), x.x()), mul_rn(R(r, 1), x.y())), mul_rn(R(r, 2), x.z())), t[r]);
+  return out;
+}
+
+// û = round(proj(K p)) with round(x) = floor(x + 0.5), from rounded operations only.
+RRG_HD inline void project_round(const Intrinsics& K, const Eigen::Vector3f& p, int& ux, int& uy) {
+  const float u = add_rn(mul_rn(K.fx, p.x()) / p.z(), K.cx), v = add_rn(mul_rn(K.fy, p.y()) / p.z(), K.cy);
+  ux = int(floorf(add_rn(u, 0.5f)));
+  uy = int(floorf(add_rn(v, 0.5f)));
+}
+
 // One pixel u: p = T_g,k V_k^l(u); û = proj(K T_ref⁻¹ p); pair with (q, m) = (V*(û), N*(û)) unless
 // |p − q| > max_distance or ∠(R N_k^l(u), m) exceeds the angle. Residual r = (p − q)·m, Jacobian
 // for the left update T ← exp(ξ) T, ξ = [ρ; φ]:  J = [mᵀ, (p × m)ᵀ]; Huber weight w = min(1, δ/|r|).
-RRG_HD inline IcpSystem icp_pixel(const IcpArgs& a, int64_t i) {
-  IcpSystem s = icp_system_zero();
+// Adds the pixel's share to s (the valid count, and the normal equations when it is an inlier);
+// accumulating in place keeps the CPU loop free of a 30-double temporary per pixel.
+RRG_HD inline void icp_accumulate(const IcpArgs& a, int64_t i, IcpSystem& s) {
   const Eigen::Vector3f v = a.src_vertices[i];
   const Eigen::Vector3f n = a.src_normals[i];
-  if (!(v.z() > 0.0f) || n.squaredNorm() < 0.5f) return s;
-  s.valid = 1.0;
-  const Eigen::Vector3f p = a.R_wc * v + a.t_wc;
-  const Eigen::Vector3f p_ref = a.R_ref_cw * p + a.t_ref_cw;
-  if (!(p_ref.z() > 0.0f)) return s;
-  const Eigen::Vector2f uv = a.K_model.project(p_ref);
-  const int ux = int(floorf(uv.x() + 0.5f)), uy = int(floorf(uv.y() + 0.5f));
-  if (!a.model_vertices.contains(ux, uy)) return s;
+  if (!(v.z() > 0.0f) || n.squaredNorm() < 0.5f) return;
+  s.valid += 1.0;
+  const Eigen::Vector3f p = rigid_rn(a.R_wc, a.t_wc, v);
+  const Eigen::Vector3f p_ref = rigid_rn(a.R_ref_cw, a.t_ref_cw, p);
+  if (!(p_ref.z() > 0.0f)) return;
+  int ux, uy;
+  project_round(a.K_model, p_ref, ux, uy);
+  if (!a.model_vertices.contains(ux, uy)) return;
   const Eigen::Vector3f m = a.model_normals(ux, uy);
-  if (m.squaredNorm() < 0.5f) return s;
+  if (m.squaredNorm() < 0.5f) return;
   const Eigen::Vector3f q = a.model_vertices(ux, uy);
   const Eigen::Vector3f d = p - q;
-  if (d.squaredNorm() > a.max_distance * a.max_distance) return s;
-  if ((a.R_wc * n).dot(m) < a.min_cos) return s;
+  if (d.squaredNorm() > a.max_distance * a.max_distance) return;
+  if ((a.R_wc * n).dot(m) < a.min_cos) return;
   const float r = d.dot(m);
   const float w = fabsf(r) <= a.huber_delta ? 1.0f : a.huber_delta / fabsf(r);
   const Eigen::Vector3f pm = p.cross(m);
   const float J[6] = {m.x(), m.y(), m.z(), pm.x(), pm.y(), pm.z()};
   int k = 0;
   for (int row = 0; row < 6; ++row) {
-    for (int col = row; col < 6; ++col) s.jtj[k++] = double(w * J[row] * J[col]);
-    s.jtr[row] = double(w * J[row] * r);
+    const float wj = w * J[row];
+    for (int col = row; col < 6; ++col) s.jtj[k++] += double(wj * J[col]);
+    s.jtr[row] += double(wj * r);
   }
-  s.r2 = double(r) * double(r);
-  s.inliers = 1.0;
+  s.r2 += double(r) * double(r);
+  s.inliers += 1.0;
+}
+
+// Pixel i alone (the CUDA reduction's per-element map).
+RRG_HD inline IcpSystem icp_pixel(const IcpArgs& a, int64_t i) {
+  IcpSystem s = icp_system_zero();
+  icp_accumulate(a, i, s);
   return s;
 }
 

@@ -118,4 +118,21 @@ BaResult optimize_pose(std::span<const BaObservation> observations, const Intrin
   return result;
 }
 
+PoseScore score_pose(std::span<const BaObservation> observations, const Intrinsics& K, double bf,
+                     const Eigen::Isometry3d& T_wc, const BaParams& params) {
+  PoseScore score;
+  const Eigen::Isometry3d T_cw = T_wc.inverse();
+  for (const BaObservation& o : observations) {
+    const Projection pr = project(o, K, bf, T_cw);
+    const double th = pr.dims == 3 ? params.chi2_stereo : params.chi2_mono;
+    if (pr.ok && pr.chi2 <= th) {
+      ++score.inliers;
+      score.cost += pr.chi2;
+    } else {
+      score.cost += th;
+    }
+  }
+  return score;
+}
+
 }  // namespace rrg

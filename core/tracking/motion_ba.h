@@ -43,4 +43,14 @@ struct PosePrior {
 BaResult optimize_pose(std::span<const BaObservation> observations, const Intrinsics& K, double bf,
                        const Eigen::Isometry3d& T_wc_init, const BaParams& params, const PosePrior* prior = nullptr);
 
+// Evidence for accepting a refinement: at a pose, the observations passing the χ² test and the
+// MSAC cost Σ_i min(χ²_i, χ²_th) (an outlier costs its threshold). Stage 2 keeps the BA pose only
+// when it beats the ICP pose on both: more or as many inliers and a lower cost.
+struct PoseScore {
+  int inliers = 0;
+  double cost = 0.0;
+};
+PoseScore score_pose(std::span<const BaObservation> observations, const Intrinsics& K, double bf,
+                     const Eigen::Isometry3d& T_wc, const BaParams& params);
+
 }  // namespace rrg

@@ -80,6 +80,15 @@ TrackResult Tracker::track(const TrackInput& in, ModelSource& model, MaskSource*
     return *orb;
   };
 
+  // Preprocessing, also on the first frame: its filtered depth is what fusion should integrate.
+  auto t0 = Clock::now();
+  std::optional<DeviceImage<float>> uploaded;
+  if (!in.depth_device || !(in.depth_device->device() == device_))
+    uploaded = DeviceImage<float>::from_host(*in.depth, device_);
+  pyramid_ = build_pyramid(uploaded ? *uploaded : *in.depth_device, K_, params_.preprocess);
+  const FramePyramid& pyramid = pyramid_;
+  r.ms_preprocess = ms_since(t0);
+
   if (!started_) {
     started_ = true;
     r.first = true;
@@ -90,13 +99,6 @@ TrackResult Tracker::track(const TrackInput& in, ModelSource& model, MaskSource*
     state_ = r.state = TrackingState::Ok;
     return r;
   }
-
-  auto t0 = Clock::now();
-  std::optional<DeviceImage<float>> uploaded;
-  if (!in.depth_device || !(in.depth_device->device() == device_))
-    uploaded = DeviceImage<float>::from_host(*in.depth, device_);
-  const FramePyramid pyramid = build_pyramid(uploaded ? *uploaded : *in.depth_device, K_, params_.preprocess);
-  r.ms_preprocess = ms_since(t0);
 
   // Stage 1: ICP against the raycast at T_{k−1}, from the constant-velocity prediction.
   t0 = Clock::now();
@@ -151,12 +153,29 @@ TrackResult Tracker::track(const TrackInput& in, ModelSource& model, MaskSource*
       const Eigen::Isometry3d T_icp = r.icp.T_wc.cast<double>();
       const bool plausible = translation_distance(ba.T_wc, T_icp) <= params_.orb.max_correction_m &&
                              rotation_distance(ba.T_wc, T_icp) <= params_.orb.max_correction_deg * std::numbers::pi / 180.0;
-      if (ba.inliers >= params_.orb.min_inliers && plausible) {
+      // Evidence: the refined pose must explain the features better than the ICP pose does.
+      const PoseScore at_icp = score_pose(obs, K_, params_.orb.baseline_fx, T_icp, params_.ba);
+      const PoseScore at_ba = score_pose(obs, K_, params_.orb.baseline_fx, ba.T_wc, params_.ba);
+      const bool better = at_ba.inliers >= at_icp.inliers && at_ba.cost < at_icp.cost;
+      bool consistent = true;
+      if (params_.orb.icp_prior_scale > 0) {
+        const Eigen::Isometry3d D = ba.T_wc * T_icp.inverse();
+        const Eigen::AngleAxisd aa(D.linear());
+        Vector6d e;
+        e.head<3>() = D.translation();
+        e.tail<3>() = aa.angle() * aa.axis();
+        consistent = e.dot(prior.information * e) <= double(params_.orb.icp_consistency_chi2);
+      }
+      if (ba.inliers >= params_.orb.min_inliers && plausible && better && consistent) {
         r.T_wc = ba.T_wc.cast<float>();
         r.orb_refined = true;
       } else {
         r.note += (r.note.empty() ? "" : "; ") + std::string("orb: ") + std::to_string(ba.inliers) + " inliers" +
-                  (plausible ? "" : ", correction too large") + ", kept the icp pose";
+                  (plausible ? "" : ", correction too large") +
+                  (consistent ? "" : ", inconsistent with the icp information") +
+                  (better ? "" : ", no better than icp (" + std::to_string(at_ba.inliers) + " vs " +
+                                     std::to_string(at_icp.inliers) + " inliers)") +
+                  ", kept the icp pose";
       }
     }
     r.ms_orb += ms_since(t0);

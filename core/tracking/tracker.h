@@ -15,6 +15,7 @@
 #include "core/tracking/keyframes.h"
 #include "core/tracking/mask_source.h"
 #include "core/tracking/model_source.h"
+#include "core/tracking/preprocess.h"
 #include "core/tracking/tracking_params.h"
 
 #include <Eigen/Geometry>
@@ -64,6 +65,14 @@ class Tracker {
   // R_k^track in icp+orb+mask mode (required there). Throws std::invalid_argument on size mismatch.
   TrackResult track(const TrackInput& input, ModelSource& model, MaskSource* masks);
 
+  // D_k after preprocessing (bilateral filter) of the last frame given to track(), on the tracker's
+  // device: the depth to fuse. At fine resolutions (640x480) Kinect-like noise (σ ≈ 2 cm at 3.5 m)
+  // exceeds the pixel spacing (7 mm), so normals from central differences of the raw depth are
+  // noise; the TSDF's point-to-plane sdf and its grazing-angle test then drop half the surface and
+  // ICP loses track (docs/tracking.md). Null before the first frame.
+  const DeviceImage<float>* preprocessed_depth() const {
+    return pyramid_.levels.empty() ? nullptr : &pyramid_.levels[0].depth;
+  }
   TrackingState state() const { return state_; }
   const KeyframeSet& keyframes() const { return keyframes_; }
   const TrackingParams& params() const { return params_; }
@@ -83,6 +92,7 @@ class Tracker {
   Eigen::Isometry3f velocity_ = Eigen::Isometry3f::Identity();  // T_{k−2}⁻¹ T_{k−1}
   TrackingState state_ = TrackingState::Ok;
   KeyframeSet keyframes_;
+  FramePyramid pyramid_;  // of the last frame
   int next_keyframe_id_ = 0;
 };
 

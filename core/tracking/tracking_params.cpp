@@ -35,6 +35,7 @@ void TrackingParams::validate() const {
   if (orb.features < 10) fail("orb.features must be >= 10");
   if (!(orb.ratio > 0 && orb.ratio <= 1)) fail("orb.ratio must be in (0, 1]");
   if (!(orb.icp_prior_scale >= 0)) fail("orb.icp_prior_scale must be >= 0");
+  if (!(orb.icp_consistency_chi2 > 0)) fail("orb.icp_consistency_chi2 must be > 0");
   if (orb.window_keyframes < 1) fail("orb.window_keyframes must be >= 1");
   if (orb.min_inliers < 6) fail("orb.min_inliers must be >= 6");
   if (ba.rounds < 1 || ba.iterations < 1) fail("ba.rounds and ba.iterations must be >= 1");

@@ -28,8 +28,11 @@ struct IcpParams {
   float ok_inlier_ratio = 0.50f;  // below (and above min): tracking degraded
   float max_jump_m = 0.30f;       // an ICP step farther than this from the motion prior diverged
   float max_jump_deg = 30.0f;
-  float converge_translation_m = 1e-5f;  // stop a level when the update is this small
-  float converge_rotation_rad = 1e-5f;
+  // Stop a level when the update moves the scene by less than ~0.1 mm: |ρ| < 0.1 mm and |φ| < 1e-4
+  // rad (0.1 mm at 1 m). That is below the depth quantisation of 16-bit depth (0.2 mm at 1/5000 m)
+  // and 10x below the 1 mm / 0.1° accuracy asked of ICP, so further steps only chase noise.
+  float converge_translation_m = 1e-4f;
+  float converge_rotation_rad = 1e-4f;
 };
 
 struct OrbParams {
@@ -48,6 +51,10 @@ struct OrbParams {
   float mask_threshold = 0.1f;    // R_k^track = mean RGB of C_r > 0.1
   float icp_prior_scale = 1e-3f;  // s of the ICP prior Λ = s JᵀJ_icp / σ_icp² in the BA (0 = none);
                                   // s < 1 because neighbouring ICP residuals are correlated
+  // Consistency gate: the BA correction Δ = log(T_ba T_icp⁻¹) must satisfy Δᵀ Λ Δ <= χ²₆(99 %)
+  // = 16.81 with the same ICP information Λ = s JᵀJ_icp / σ_icp² as the prior (off when s = 0):
+  // ORB may move the pose along directions the geometry leaves weak, not against what it fixes.
+  float icp_consistency_chi2 = 16.81f;
   float baseline_fx = 40.0f;      // b·f_x (pixels·m) of the virtual stereo residual (ORB-SLAM2 RGB-D)
 };
 
