@@ -268,7 +268,11 @@ FrameReport Session::process(const SessionFrame& frame) {
     {
       std::lock_guard lock(s.volume_mutex);
       const ReflectionObservation obs{&plane_ids, &mask, s.remap};  // written by this thread only
-      integrate(s.volume, depth, color, s.K, report.T_wc, identify ? &obs : nullptr);
+      // D_k after the bilateral filter: at fine resolutions the raw depth's noise exceeds the pixel
+      // spacing and fusion's normals (point-to-plane sdf, grazing test) would drop the surface
+      // (docs/tracking.md); with given poses nothing was preprocessed and the raw depth is fused.
+      const DeviceImage<float>* filtered = s.config.gt_poses ? nullptr : s.tracker.preprocessed_depth();
+      integrate(s.volume, filtered ? *filtered : depth, color, s.K, report.T_wc, identify ? &obs : nullptr);
     }
     s.model.invalidate();
     report.times.fuse = ms_since(tf);
