@@ -1,6 +1,7 @@
 // TSDF fusion, raycast and mesh extraction (paper §4.1.4) per frame on a synthetic living_room
 // sequence (rendered once per resolution by core/synth into a temporary folder), at the paper's
-// defaults (voxel 0.5 cm, ε = 2 cm), on every available device. Frames are on the device already.
+// defaults (ε = 2 cm) with voxels of 0.5 cm (the paper's) and 1 cm, on every available device.
+// Frames are on the device already. Names: tsdf_<stage>_<w>x<h>/<voxel mm>mm/<device>.
 #include "core/io/dataset.h"
 #include "core/synth/sequence.h"
 #include "core/tsdf/tsdf_integrate.h"
@@ -64,10 +65,16 @@ DeviceFrames upload(const Sequence& s, const rrg::Device& device) {
   return f;
 }
 
-void BM_Fuse(benchmark::State& state, rrg::Device device, int w, int h) {
+rrg::TsdfParams params(float voxel) {
+  rrg::TsdfParams p;
+  p.voxel_size = voxel;
+  return p;
+}
+
+void BM_Fuse(benchmark::State& state, rrg::Device device, int w, int h, float voxel) {
   const Sequence& s = sequence(w, h);
   const DeviceFrames f = upload(s, device);
-  rrg::TsdfVolume volume(rrg::TsdfParams{}, device);
+  rrg::TsdfVolume volume(params(voxel), device);
   size_t i = 0, blocks = 0;
   for (auto _ : state) {
     blocks = size_t(rrg::integrate(volume, f.depth[i % kFrames], f.color[i % kFrames], s.K, f.poses[i % kFrames]));
@@ -77,16 +84,16 @@ void BM_Fuse(benchmark::State& state, rrg::Device device, int w, int h) {
   state.counters["fps"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
 }
 
-rrg::TsdfVolume fused_volume(const Sequence& s, const DeviceFrames& f, const rrg::Device& device) {
-  rrg::TsdfVolume volume(rrg::TsdfParams{}, device);
+rrg::TsdfVolume fused_volume(const Sequence& s, const DeviceFrames& f, const rrg::Device& device, float voxel) {
+  rrg::TsdfVolume volume(params(voxel), device);
   for (int i = 0; i < kFrames; ++i) rrg::integrate(volume, f.depth[size_t(i)], f.color[size_t(i)], s.K, f.poses[size_t(i)]);
   return volume;
 }
 
-void BM_Raycast(benchmark::State& state, rrg::Device device, int w, int h) {
+void BM_Raycast(benchmark::State& state, rrg::Device device, int w, int h, float voxel) {
   const Sequence& s = sequence(w, h);
   const DeviceFrames f = upload(s, device);
-  const rrg::TsdfVolume volume = fused_volume(s, f, device);
+  const rrg::TsdfVolume volume = fused_volume(s, f, device, voxel);
   size_t i = 0;
   for (auto _ : state) {
     const rrg::RaycastResult r = rrg::raycast(volume, s.K, f.poses[i++ % kFrames]);
@@ -95,10 +102,10 @@ void BM_Raycast(benchmark::State& state, rrg::Device device, int w, int h) {
   state.counters["fps"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
 }
 
-void BM_Extract(benchmark::State& state, rrg::Device device, int w, int h) {
+void BM_Extract(benchmark::State& state, rrg::Device device, int w, int h, float voxel) {
   const Sequence& s = sequence(w, h);
   const DeviceFrames f = upload(s, device);
-  const rrg::TsdfVolume volume = fused_volume(s, f, device);
+  const rrg::TsdfVolume volume = fused_volume(s, f, device, voxel);
   size_t triangles = 0;
   for (auto _ : state) triangles = rrg::extract_mesh(volume).triangles.size();
   state.counters["triangles"] = double(triangles);
@@ -107,15 +114,18 @@ void BM_Extract(benchmark::State& state, rrg::Device device, int w, int h) {
 
 const bool registered = [] {
   for (const rrg::Device& device : rrg::available_devices())
-    for (auto [w, h] : {std::pair{640, 480}, std::pair{1280, 720}}) {
-      const std::string tag = std::to_string(w) + "x" + std::to_string(h) + "/" + device.to_string();
-      benchmark::RegisterBenchmark(("tsdf_fuse_" + tag).c_str(), BM_Fuse, device, w, h)
-          ->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
-      benchmark::RegisterBenchmark(("tsdf_raycast_" + tag).c_str(), BM_Raycast, device, w, h)
-          ->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
-      benchmark::RegisterBenchmark(("tsdf_extract_" + tag).c_str(), BM_Extract, device, w, h)
-          ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
-    }
+    for (auto [w, h] : {std::pair{320, 240}, std::pair{640, 480}, std::pair{1280, 720}})
+      for (const int voxel_mm : {5, 10}) {
+        const std::string tag = std::to_string(w) + "x" + std::to_string(h) + "/" +
+                                std::to_string(voxel_mm) + "mm/" + device.to_string();
+        const float voxel = float(voxel_mm) * 1e-3f;
+        benchmark::RegisterBenchmark(("tsdf_fuse_" + tag).c_str(), BM_Fuse, device, w, h, voxel)
+            ->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+        benchmark::RegisterBenchmark(("tsdf_raycast_" + tag).c_str(), BM_Raycast, device, w, h, voxel)
+            ->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+        benchmark::RegisterBenchmark(("tsdf_extract_" + tag).c_str(), BM_Extract, device, w, h, voxel)
+            ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+      }
   return true;
 }();
 

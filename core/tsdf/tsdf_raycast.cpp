@@ -18,8 +18,12 @@ RaycastResult raycast(const TsdfVolume& volume, const Intrinsics& K, const Eigen
                   DeviceImage<uint8_t>(w, h, dev),         DeviceImage<float>(w, h, dev)};
   const auto remap = Buffer<int32_t>::from_host(plane_remap, dev);
   const TsdfParams& p = volume.params();
+  const int tiles_x = (w + kernel::kRangeTile - 1) / kernel::kRangeTile;
+  const int tiles_y = (h + kernel::kRangeTile - 1) / kernel::kRangeTile;
+  Buffer<int32_t> near(size_t(tiles_x) * size_t(tiles_y), dev), far(size_t(tiles_x) * size_t(tiles_y), dev);
   kernel::RaycastArgs a{{volume.hash_view(), volume.voxels(), p.voxel_size},
-                        K, T_wc.linear(), T_wc.translation(), p.truncation, p.min_depth, p.max_depth,
+                        volume.block_keys(), K, T_wc.linear(), T_wc.translation(), p.truncation,
+                        p.min_depth, p.max_depth, {near.span(), far.span(), tiles_x, tiles_y},
                         remap.span(), r.depth.view(), r.vertices.view(), r.normals.view(), r.colors.view(),
                         r.plane_ids.view(), r.reflection.view(), r.reflection_mask.view(),
                         r.color_variance.view()};

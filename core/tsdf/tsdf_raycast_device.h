@@ -7,41 +7,47 @@
 
 namespace rrg::kernel {
 
+inline constexpr int kRefineSteps = 8;     // at most, per hit
+inline constexpr float kRefineTol = 1e-3f;  // stop when the bracket is shorter (voxels)
+
 struct RayHit {
   bool hit = false;
   float z = 0.0f;              // depth along the optical axis
   Eigen::Vector3f p_w = Eigen::Vector3f::Zero();
 };
 
-// Distance (in units of the ray parameter) to leave the block containing p along dir.
+// Distance (in units of the ray parameter) to leave the block region [8b, 8b + 8) · s that holds
+// p along dir. A trilinear sample at p needs its lower corner voxel floor(p / s), so no point of the
+// region of an unallocated block has a valid sample.
 RRG_HD inline float block_exit(const Eigen::Vector3f& p, const Eigen::Vector3f& dir, float voxel_size) {
   const float block_size = voxel_size * kBlockSide;
   float t_exit = 1e30f;
   for (int k = 0; k < 3; ++k) {
     if (dir[k] == 0.0f) continue;
-    // voxel g covers [g - 1/2, g + 1/2) · s; block b covers voxels [8b, 8b + 7]
-    const float q = p[k] / voxel_size + 0.5f;
-    const float b = floorf(q / kBlockSide);
-    const float lo = (b * kBlockSide - 0.5f) * voxel_size, hi = lo + block_size;
+    const float lo = floorf(p[k] / block_size) * block_size, hi = lo + block_size;
     const float t = ((dir[k] > 0.0f ? hi : lo) - p[k]) / dir[k];
     t_exit = fminf(t_exit, t);
   }
   return fmaxf(t_exit, 0.0f);
 }
 
-// March from z = min_depth to max_depth along o + z · d (d has unit z in the camera frame) and
-// return the first +/− zero crossing of the trilinear TSDF, refined by two secant steps.
+// March from depth z_start to z_end along o + z · d (d has unit z in the camera frame) and return
+// the first +/− zero crossing of the trilinear TSDF, refined by regula falsi. Steps:
+//   block of floor(p / s) not allocated       → to the ray's exit from that block (DDA over blocks);
+//   sample invalid (a corner unobserved)      → one voxel;
+//   f = d/ε > 0                               → max(s, 0.8 · f · ε) (the TSDF is a distance bound);
+//   f ≤ 0 without a positive sample before    → one voxel (entering from behind a surface).
 RRG_HD inline RayHit march(const VolumeView& vol, const Eigen::Vector3f& o, const Eigen::Vector3f& d,
-                           float truncation, float min_depth, float max_depth) {
+                           float truncation, float z_start, float z_end) {
   RayHit hit;
   BlockCache cache;
   const float len = d.norm();           // metres per unit of z
   const float s = vol.voxel_size;
-  float z = min_depth, z_prev = 0.0f, f_prev = 0.0f;
+  float z = z_start, z_prev = 0.0f, f_prev = 0.0f;
   bool have_prev = false;
-  while (z < max_depth) {
+  while (z < z_end) {
     const Eigen::Vector3f p = o + z * d;
-    const Eigen::Vector3i g(int(floorf(p.x() / s + 0.5f)), int(floorf(p.y() / s + 0.5f)), int(floorf(p.z() / s + 0.5f)));
+    const Eigen::Vector3i g(int(floorf(p.x() / s)), int(floorf(p.y() / s)), int(floorf(p.z() / s)));
     if (!voxel_at(vol, g, cache)) {  // empty space: skip the whole block
       z += block_exit(p, d, s) + 1e-3f * s / len;
       have_prev = false;
@@ -54,17 +60,24 @@ RRG_HD inline RayHit march(const VolumeView& vol, const Eigen::Vector3f& o, cons
       continue;
     }
     if (have_prev && f_prev > 0.0f && f <= 0.0f) {
+      // Regula falsi with the Illinois modification on the bracket [z_prev, z]: the trilinear TSDF
+      // is cubic along the ray, so plain secant steps can stall on one side of a large bracket.
       float za = z_prev, fa = f_prev, zb = z, fb = f;
       float zc = za + (zb - za) * fa / (fa - fb);
-      for (int it = 0; it < 2; ++it) {
+      int side = 0;
+      for (int it = 0; it < kRefineSteps && (zb - za) * len > kRefineTol * s; ++it) {
         float fc;
         if (!sample_tsdf(vol, o + zc * d, cache, fc)) break;
         if (fc > 0.0f) {
           za = zc;
           fa = fc;
+          if (side == 1) fb *= 0.5f;
+          side = 1;
         } else {
           zb = zc;
           fb = fc;
+          if (side == -1) fa *= 0.5f;
+          side = -1;
         }
         if (fa - fb <= 0.0f) break;
         zc = za + (zb - za) * fa / (fa - fb);
@@ -118,7 +131,7 @@ RRG_HD inline SurfaceSample shade(const VolumeView& vol, const Eigen::Vector3f& 
   for (int k = 0; k < 3 && ok; ++k) {
     Eigen::Vector3f e = Eigen::Vector3f::Zero();
     e[k] = s;
-    float fp, fm;
+    float fp = 0.0f, fm = 0.0f;
     ok = sample_tsdf(vol, p + e, cache, fp) && sample_tsdf(vol, p - e, cache, fm);
     grad[k] = fp - fm;
   }

@@ -45,16 +45,30 @@ RRG_HD inline bool trilinear_corners(const VolumeView& vol, const Eigen::Vector3
   const Eigen::Vector3f f = q - b;
   const Eigen::Vector3i base(int(b.x()), int(b.y()), int(b.z()));
   const int lx = local_of(base.x()), ly = local_of(base.y()), lz = local_of(base.z());
-  const Voxel* inner = nullptr;  // all 8 corners in one block: one lookup, direct indexing
-  if (lx < kBlockSide - 1 && ly < kBlockSide - 1 && lz < kBlockSide - 1) {
-    inner = voxel_at(vol, base, cache);
-    if (!inner) return false;
+  // The corners lie in the base voxel's block and, where a local coordinate is 7, in its +x / +y / +z
+  // neighbours: each of those blocks is looked up once (the cache keeps the base block).
+  const bool ox = lx == kBlockSide - 1, oy = ly == kBlockSide - 1, oz = lz == kBlockSide - 1;
+  const Voxel* first[8] = {};  // voxel 0 of each neighbouring block (bit 0: +x, 1: +y, 2: +z)
+  {
+    const Voxel* v0 = voxel_at(vol, Eigen::Vector3i(base.x() & ~7, base.y() & ~7, base.z() & ~7), cache);
+    if (!v0) return false;
+    first[0] = v0;
+  }
+  const int bx = block_of(base.x()), by = block_of(base.y()), bz = block_of(base.z());
+  for (int o = 1; o < 8; ++o) {
+    const int dx = o & 1, dy = (o >> 1) & 1, dz = o >> 2;
+    if ((dx && !ox) || (dy && !oy) || (dz && !oz)) continue;
+    if (!block_in_range(bx + dx, by + dy, bz + dz)) return false;
+    const int32_t b = hash_find(vol.hash, block_key(bx + dx, by + dy, bz + dz));
+    if (b < 0) return false;
+    first[o] = &vol.voxels[int64_t(b) * kBlockVoxels];
   }
   for (int c = 0; c < 8; ++c) {
     const int dx = c & 1, dy = (c >> 1) & 1, dz = c >> 2;
-    const Voxel* v = inner ? inner + (dx + kBlockSide * (dy + kBlockSide * dz))
-                           : voxel_at(vol, base + Eigen::Vector3i(dx, dy, dz), cache);
-    if (!v || v->weight == 0) return false;
+    const int x = lx + dx, y = ly + dy, z = lz + dz;
+    const int o = (x >> 3) | ((y >> 3) << 1) | ((z >> 3) << 2);
+    const Voxel* v = first[o] + local_index(x & 7, y & 7, z & 7);
+    if (v->weight == 0) return false;
     out.v[c] = v;
     out.w[c] = (dx ? f.x() : 1.0f - f.x()) * (dy ? f.y() : 1.0f - f.y()) * (dz ? f.z() : 1.0f - f.z());
   }

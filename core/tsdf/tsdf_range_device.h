@@ -1,0 +1,111 @@
+#pragma once
+// The coarse range image of the raycast (InfiniTAM's min/max depth image): every resident block is
+// projected into a grid of kRangeTile² pixel tiles, and each tile keeps the nearest and farthest
+// depth at which a block it overlaps can be met. A ray then marches only within its tile's
+// [near, far], and a tile no block projects into is a miss without any volume lookup.
+//
+// Conservative by construction: a trilinear sample at p needs its lower corner voxel floor(p / s) in
+// an allocated block b, so every valid sample lies in the box [8b, 8b + 8] · s of some block; z is
+// linear, so the depth of a ray point in that box lies between the depths of the box's corners, and
+// the pixel lies inside the bounding rectangle of their projections.
+#include "core/common/atomics.h"
+#include "core/common/camera.h"
+#include "core/common/span.h"
+#include "core/tsdf/voxel.h"
+
+#include <Eigen/Core>
+
+#include <cstring>
+
+namespace rrg::kernel {
+
+inline constexpr int kRangeTile = 8;        // pixels per tile side
+inline constexpr float kNoDepth = 1e30f;   // "no block" sentinel (near of an empty tile)
+
+// Depths are positive floats, whose bit patterns order like the floats, so the tiles keep int32
+// bits and update them with atomic_max: far as +bits, near as −bits.
+RRG_HD inline int32_t float_bits(float f) {
+#if defined(__CUDA_ARCH__)
+  return __float_as_int(f);
+#else
+  int32_t i;
+  std::memcpy(&i, &f, sizeof i);
+  return i;
+#endif
+}
+RRG_HD inline float bits_float(int32_t i) {
+#if defined(__CUDA_ARCH__)
+  return __int_as_float(i);
+#else
+  float f;
+  std::memcpy(&f, &i, sizeof f);
+  return f;
+#endif
+}
+
+struct RangeImage {
+  Span<int32_t> near_neg;  // [tiles] −bits(nearest depth); empty: −bits(+inf)
+  Span<int32_t> far;       // [tiles] bits(farthest depth); empty: bits(0)
+  int tiles_x = 0, tiles_y = 0;
+};
+
+RRG_HD inline void range_clear(const RangeImage& r, int64_t tile) {
+  r.near_neg[tile] = -float_bits(kNoDepth);
+  r.far[tile] = 0;
+}
+
+// [near, far] of the tile holding pixel (x, y); near > far when no block projects there.
+RRG_HD inline void range_at(const RangeImage& r, int x, int y, float& near, float& far) {
+  const int64_t t = int64_t(y / kRangeTile) * r.tiles_x + x / kRangeTile;
+  near = bits_float(-r.near_neg[t]);
+  far = bits_float(r.far[t]);
+}
+
+// Projects block `key` (camera R_cw, t_cw) into the tiles it may cover.
+RRG_HD inline void range_splat_block(const RangeImage& r, uint64_t key, float voxel_size, const Intrinsics& K,
+                                     const Eigen::Matrix3f& R_cw, const Eigen::Vector3f& t_cw, float min_depth,
+                                     float max_depth) {
+  const Eigen::Vector3f lo = (block_coord(key) * int(kBlockSide)).cast<float>() * voxel_size;
+  const float side = float(kBlockSide) * voxel_size;
+  float z_lo = kNoDepth, z_hi = 0.0f;
+  float u_lo = kNoDepth, u_hi = -kNoDepth;
+  float v_lo = kNoDepth, v_hi = -kNoDepth;
+  bool behind = false;  // a corner at or behind the camera plane: the footprint is unbounded
+  for (int c = 0; c < 8; ++c) {
+    const Eigen::Vector3f p = lo + side * Eigen::Vector3f(float(c & 1), float((c >> 1) & 1), float(c >> 2));
+    const Eigen::Vector3f q = R_cw * p + t_cw;
+    z_lo = fminf(z_lo, q.z());
+    z_hi = fmaxf(z_hi, q.z());
+    if (q.z() <= 1e-4f) {
+      behind = true;
+      continue;
+    }
+    const Eigen::Vector2f uv = K.project(q);
+    u_lo = fminf(u_lo, uv.x());
+    u_hi = fmaxf(u_hi, uv.x());
+    v_lo = fminf(v_lo, uv.y());
+    v_hi = fmaxf(v_hi, uv.y());
+  }
+  if (z_hi < min_depth || z_lo > max_depth) return;
+  z_lo = fmaxf(z_lo, min_depth);
+  int tx0 = 0, ty0 = 0, tx1 = r.tiles_x - 1, ty1 = r.tiles_y - 1;
+  if (!behind) {  // one pixel of slack for rounding
+    if (u_hi < -1.0f || v_hi < -1.0f || u_lo > float(K.width) || v_lo > float(K.height)) return;
+    const auto tile = [](float u, int n) {  // clamped before the conversion (u may be huge)
+      return int(fminf(fmaxf(floorf(u / float(kRangeTile)), 0.0f), float(n - 1)));
+    };
+    tx0 = tile(u_lo - 1.0f, r.tiles_x);
+    ty0 = tile(v_lo - 1.0f, r.tiles_y);
+    tx1 = tile(u_hi + 1.0f, r.tiles_x);
+    ty1 = tile(v_hi + 1.0f, r.tiles_y);
+  }
+  const int32_t near_neg = -float_bits(z_lo), far = float_bits(z_hi);
+  for (int ty = ty0; ty <= ty1; ++ty)
+    for (int tx = tx0; tx <= tx1; ++tx) {
+      const int64_t t = int64_t(ty) * r.tiles_x + tx;
+      atomic_max(&r.near_neg[t], near_neg);
+      atomic_max(&r.far[t], far);
+    }
+}
+
+}  // namespace rrg::kernel
