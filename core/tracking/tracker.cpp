@@ -183,7 +183,8 @@ TrackResult Tracker::track(const TrackInput& in, ModelSource& model, MaskSource*
 
   r.state = r.relocalised || r.icp.inlier_ratio < params_.icp.ok_inlier_ratio ? TrackingState::Degraded : TrackingState::Ok;
   state_ = r.state;
-  if (r.state == TrackingState::Ok && needs_keyframe(keyframes_.back().T_wc, r.T_wc, params_.keyframes)) {
+  if (r.state == TrackingState::Ok &&
+      (keyframes_.empty() || needs_keyframe(keyframes_.back().T_wc, r.T_wc, params_.keyframes))) {  // empty after resume()
     add_keyframe(in.index, r.T_wc, orb_at(r.T_wc));
     r.keyframe = true;
   }
