@@ -38,7 +38,7 @@
 
 namespace rrg {
 
-struct ConfigField;  // core/slam/session_config.h
+struct ConfigTable;  // core/slam/session_config.h
 
 struct MapperParams {            // paper defaults (DESIGN.md §5); validate() throws invalid_argument
   int iterations = 30;           // per mapping step
@@ -60,8 +60,8 @@ struct MapperParams {            // paper defaults (DESIGN.md §5); validate() t
   LossWeights loss_weights() const { return {lambda_ssim, lambda_depth, lambda_sobel}; }
 };
 
-// The named fields of MapperParams for configuration files and --set (names without "mapping.").
-std::vector<ConfigField> mapper_config_fields(MapperParams& p);
+// Adds the named fields of MapperParams to a session's configuration table (as "mapping.<name>").
+void add_mapper_config_fields(ConfigTable& t, MapperParams& p);
 
 struct MappingFrame {            // one posed RGB-D frame (host)
   int64_t index = 0;

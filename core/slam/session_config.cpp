@@ -53,33 +53,6 @@ std::string float_text(float v) {
   return s.str();
 }
 
-struct Table {
-  std::vector<ConfigField> fields;
-  void f(std::string name, float& v, std::string help) {
-    fields.push_back({name, std::move(help), [&v] { return float_text(v); },
-                      [&v, name](const std::string& t) { v = parse_float(name, t); }});
-  }
-  void i(std::string name, int& v, std::string help) {
-    fields.push_back({name, std::move(help), [&v] { return std::to_string(v); },
-                      [&v, name](const std::string& t) { v = parse_int(name, t); }});
-  }
-  void i64(std::string name, int64_t& v, std::string help) {
-    fields.push_back({name, std::move(help), [&v] { return std::to_string(v); },
-                      [&v, name](const std::string& t) { v = parse_int(name, t); }});
-  }
-  void b(std::string name, bool& v, std::string help) {
-    fields.push_back({name, std::move(help), [&v] { return std::string(v ? "true" : "false"); },
-                      [&v, name](const std::string& t) { v = parse_bool(name, t); }});
-  }
-  void s(std::string name, std::string& v, std::string help) {
-    fields.push_back({name, std::move(help), [&v] { return v; }, [&v](const std::string& t) { v = trim(t); }});
-  }
-  void custom(std::string name, std::string help, std::function<std::string()> get,
-              std::function<void(const std::string&)> set) {
-    fields.push_back({std::move(name), std::move(help), std::move(get), std::move(set)});
-  }
-};
-
 // Levenshtein distance, for "did you mean" suggestions.
 size_t edit_distance(const std::string& a, const std::string& b) {
   std::vector<size_t> row(b.size() + 1);
@@ -115,7 +88,43 @@ void walk_yaml(SessionConfig& c, const YAML::Node& node, const std::string& pref
   }
 }
 
+uint64_t parse_u64(const std::string& key, const std::string& text) {
+  const std::string t = trim(text);
+  uint64_t v = 0;
+  const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
+  if (t.empty() || r.ec != std::errc() || r.ptr != t.data() + t.size()) bad_value(key, text, "a non-negative integer");
+  return v;
+}
+
 }  // namespace
+
+void ConfigTable::f(const std::string& name, float& v, std::string help) {
+  fields.push_back({prefix + name, std::move(help), [&v] { return float_text(v); },
+                    [&v, n = prefix + name](const std::string& t) { v = parse_float(n, t); }});
+}
+void ConfigTable::i(const std::string& name, int& v, std::string help) {
+  fields.push_back({prefix + name, std::move(help), [&v] { return std::to_string(v); },
+                    [&v, n = prefix + name](const std::string& t) { v = parse_int(n, t); }});
+}
+void ConfigTable::i64(const std::string& name, int64_t& v, std::string help) {
+  fields.push_back({prefix + name, std::move(help), [&v] { return std::to_string(v); },
+                    [&v, n = prefix + name](const std::string& t) { v = parse_int(n, t); }});
+}
+void ConfigTable::u64(const std::string& name, uint64_t& v, std::string help) {
+  fields.push_back({prefix + name, std::move(help), [&v] { return std::to_string(v); },
+                    [&v, n = prefix + name](const std::string& t) { v = parse_u64(n, t); }});
+}
+void ConfigTable::b(const std::string& name, bool& v, std::string help) {
+  fields.push_back({prefix + name, std::move(help), [&v] { return std::string(v ? "true" : "false"); },
+                    [&v, n = prefix + name](const std::string& t) { v = parse_bool(n, t); }});
+}
+void ConfigTable::s(const std::string& name, std::string& v, std::string help) {
+  fields.push_back({prefix + name, std::move(help), [&v] { return v; }, [&v](const std::string& t) { v = trim(t); }});
+}
+void ConfigTable::custom(const std::string& name, std::string help, std::function<std::string()> get,
+                         std::function<void(const std::string&)> set) {
+  fields.push_back({prefix + name, std::move(help), std::move(get), std::move(set)});
+}
 
 void SessionConfig::validate() const {
   if (!K.valid())
@@ -140,7 +149,7 @@ void SessionConfig::validate() const {
 }
 
 std::vector<ConfigField> config_fields(SessionConfig& c) {
-  Table t;
+  ConfigTable t;
   // camera
   t.f("camera.fx", c.K.fx, "focal length x, pixels");
   t.f("camera.fy", c.K.fy, "focal length y, pixels");
@@ -199,10 +208,8 @@ std::vector<ConfigField> config_fields(SessionConfig& c) {
   t.f("planes.table.max_normal_angle_deg", c.planes.table.max_normal_angle_deg, "association normal limit");
   t.f("planes.table.max_distance", c.planes.table.max_distance, "association distance limit, metres");
   // mapping (§4.2)
-  for (ConfigField& f : mapper_config_fields(c.mapping)) {
-    f.name = "mapping." + f.name;
-    t.fields.push_back(std::move(f));
-  }
+  t.prefix = "mapping.";
+  add_mapper_config_fields(t, c.mapping);
   return t.fields;
 }
 

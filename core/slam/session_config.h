@@ -48,6 +48,21 @@ struct ConfigField {
   std::function<void(const std::string&)> set;  // parses text; throws std::invalid_argument
 };
 
+// Builds field tables with one text form for every type (floats to 9 significant digits, so a
+// learning rate of 1.6e-4 survives a YAML round trip) and parse errors that name the field.
+struct ConfigTable {
+  std::vector<ConfigField> fields;
+  std::string prefix;  // prepended to every name ("mapping.")
+  void f(const std::string& name, float& v, std::string help);
+  void i(const std::string& name, int& v, std::string help);
+  void i64(const std::string& name, int64_t& v, std::string help);
+  void u64(const std::string& name, uint64_t& v, std::string help);
+  void b(const std::string& name, bool& v, std::string help);
+  void s(const std::string& name, std::string& v, std::string help);
+  void custom(const std::string& name, std::string help, std::function<std::string()> get,
+              std::function<void(const std::string&)> set);
+};
+
 // The table of every configurable field of c (pointers into c: keep c alive while using it).
 std::vector<ConfigField> config_fields(SessionConfig& c);
 
