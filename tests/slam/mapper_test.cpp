@@ -97,6 +97,14 @@ TEST(Mapper, StepsAreDeterministicAndKeepTheBooks) {
 }
 
 TEST(Mapper, FitsOneViewAbove35dB) {
+  // One thread: the renderer's CPU backward adds gradients with atomics, so with more threads the
+  // fit differs from run to run (33.4 to 35.6 dB seen in CI); on one thread it is reproducible.
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+  struct Restore {
+    int n;
+    ~Restore() { omp_set_num_threads(n); }
+  } restore{threads};
   test::MapperSceneParams sp;
   sp.preset = "living_room";
   sp.width = 64;
