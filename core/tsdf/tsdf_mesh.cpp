@@ -6,6 +6,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <tuple>
 #include <unordered_map>
 
 namespace rrg {
@@ -109,6 +110,17 @@ TriangleMesh mesh_pool_blocks(const TsdfVolume& volume, const std::vector<int32_
   return mesh;
 }
 
+// Orders pool slots by their block's coordinates (x, then y, then z), so the mesh's vertex and
+// triangle order depends on the map only, not on the order its blocks were allocated (a map
+// restored from a snapshot then meshes to the same bytes).
+void sort_by_coords(std::vector<int32_t>& blocks, const std::vector<Eigen::Vector3i>& coords) {
+  std::sort(blocks.begin(), blocks.end(), [&](int32_t a, int32_t b) {
+    const Eigen::Vector3i& ca = coords[size_t(a)];
+    const Eigen::Vector3i& cb = coords[size_t(b)];
+    return std::tie(ca.x(), ca.y(), ca.z()) < std::tie(cb.x(), cb.y(), cb.z());
+  });
+}
+
 }  // namespace
 
 TriangleMesh extract_mesh(const TsdfVolume& volume, std::span<const int32_t> plane_remap) {
@@ -117,6 +129,7 @@ TriangleMesh extract_mesh(const TsdfVolume& volume, std::span<const int32_t> pla
                  "(stream_in_all() first to mesh everything)", volume.num_host_blocks());
   std::vector<int32_t> blocks(size_t(volume.num_blocks()));
   for (size_t i = 0; i < blocks.size(); ++i) blocks[i] = int32_t(i);
+  sort_by_coords(blocks, volume.block_coords());
   return mesh_pool_blocks(volume, blocks, plane_remap);
 }
 
@@ -130,6 +143,7 @@ TriangleMesh extract_mesh(const TsdfVolume& volume, std::span<const Eigen::Vecto
     if (auto it = index.find(block_key(c.x(), c.y(), c.z())); it != index.end()) blocks.push_back(it->second);
   std::sort(blocks.begin(), blocks.end());
   blocks.erase(std::unique(blocks.begin(), blocks.end()), blocks.end());
+  sort_by_coords(blocks, all);
   return mesh_pool_blocks(volume, blocks, plane_remap);
 }
 

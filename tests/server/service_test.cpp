@@ -219,6 +219,7 @@ TEST(Service, SaveKillNineLoadRestoresTheMap) {
   EXPECT_GT(mesh_after.triangles, 0u);
   EXPECT_EQ(spz_after.count, spz_before.count);
   EXPECT_TRUE(spz_after.data == spz_before.data) << "SPZ bytes differ after load";
+  EXPECT_TRUE(mesh_after.data == mesh_before.data) << "Draco bytes differ after load";
   std::printf("[ after load: mesh %zu/%zu vertices/triangles, Draco bytes %s; %zu Gaussians ]\n", size_t(mesh_after.count),
               size_t(mesh_after.triangles), mesh_after.data == mesh_before.data ? "identical" : "differ",
               size_t(spz_after.count));
