@@ -109,7 +109,8 @@ PlaneEvalReport run_plane_eval(const PlaneEvalOptions& options) {
       if (needs_labels) labels = io::read_synth_labels(options.dataset, k);
       const LabelImage gt = io::read_synth_planes(options.dataset, k);
       const MaskImage gt_reflection = io::read_synth_reflection(options.dataset, k);
-      IdentificationFrame f{&frame.depth, &frame.color, needs_labels ? &labels : nullptr, K, T_wc, int64_t(k)};
+      IdentificationFrame f{&frame.depth, &frame.color, needs_labels ? &labels : nullptr, K, T_wc, int64_t(k),
+                            options.fuse ? options.voxel_size : 0.0f};
       for (size_t c = 0; c < identifiers.size(); ++c) {
         IdentificationResult r = identifiers[c].identify(f, cvar);
         accumulate(time_sums[c], r.timings);

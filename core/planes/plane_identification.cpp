@@ -2,13 +2,36 @@
 
 #include <spdlog/fmt/fmt.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <map>
 #include <stdexcept>
 
 namespace rrg {
 
 namespace {
+
+// Pixels at least `border_m` (on the image at their depth) inside their region of `map`: every
+// pixel of the square of radius ceil(border_m · fx / z) around them carries the same non-zero value.
+template <class T>
+MaskImage interior(const Image<T>& map, const DepthImage& depth, const Intrinsics& K, float border_m) {
+  const int w = map.width(), h = map.height();
+  MaskImage inner(w, h, 0);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const T id = map(x, y);
+      const float z = depth(x, y);
+      if (id == T(0) || !(z > 0)) continue;
+      const int r = border_m > 0 ? std::min(16, int(std::ceil(border_m * K.fx / z))) : 0;
+      bool ok = x - r >= 0 && y - r >= 0 && x + r < w && y + r < h;
+      for (int v = y - r; ok && v <= y + r; ++v)
+        for (int u = x - r; ok && u <= x + r; ++u) ok = map(u, v) == id;
+      inner(x, y) = ok ? 1 : 0;
+    }
+  return inner;
+}
+
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -21,6 +44,8 @@ void IdentificationParams::validate() const {
   if (!(variance_threshold >= 0)) throw std::invalid_argument("IdentificationParams: variance_threshold must be >= 0");
   if (!(area_threshold >= 0 && area_threshold < 1))
     throw std::invalid_argument("IdentificationParams: area_threshold must be in [0, 1)");
+  if (!(variance_border_voxels >= 0 && variance_border_voxels <= 64))
+    throw std::invalid_argument("IdentificationParams: variance_border_voxels must be in [0, 64]");
   if (!(min_mask_overlap >= 0 && min_mask_overlap <= 1))
     throw std::invalid_argument("IdentificationParams: min_mask_overlap must be in [0, 1]");
 }
@@ -59,11 +84,20 @@ IdentificationResult PlaneIdentifier::identify(const IdentificationFrame& frame,
     if (!m.mask.same_size(depth)) throw std::runtime_error("semantic cue " + cue_->name() + ": mask size differs from the frame");
   // Per global plane: pixels, pixels above δ_v, and overlap (all pixels, pixels above δ_v) with
   // every mask; per mask its pixel count.
+  // The variance counts (high_variance, overlap_inner, overlap_high) use the plane's interior
+  // pixels only (IdentificationParams::variance_border_voxels).
   struct Stats {
-    int64_t pixels = 0, high_variance = 0;
+    int64_t pixels = 0, inner = 0, high_variance = 0;
     double variance_sum = 0;
-    std::vector<int64_t> overlap, overlap_high;
+    std::vector<int64_t> overlap, overlap_inner, overlap_high;
   };
+  // Interiors: of the planes, and of the reflective masks (a colour edge at a mask's border
+  // aliases into C_var the same way a plane border does).
+  const float border_m = params_.variance_border_voxels * std::max(frame.voxel_size, 0.0f);
+  const MaskImage plane_inner = interior(out.global_map, depth, frame.K, border_m);
+  std::vector<MaskImage> mask_inner(masks.size());
+  for (size_t m = 0; m < masks.size(); ++m)
+    if (masks[m].reflective) mask_inner[m] = interior(masks[m].mask, depth, frame.K, border_m);
   std::map<int, Stats> stats;
   std::vector<int64_t> mask_pixels(masks.size(), 0);
   for (size_t i = 0; i < out.global_map.size(); ++i) {
@@ -71,13 +105,21 @@ IdentificationResult PlaneIdentifier::identify(const IdentificationFrame& frame,
     const int id = out.global_map[i];
     if (id == 0) continue;
     Stats& s = stats[id];
-    if (s.overlap.empty()) s.overlap.assign(masks.size(), 0), s.overlap_high.assign(masks.size(), 0);
+    if (s.overlap.empty())
+      s.overlap.assign(masks.size(), 0), s.overlap_inner.assign(masks.size(), 0), s.overlap_high.assign(masks.size(), 0);
     ++s.pixels;
-    const bool high = color_variance[i] > params_.variance_threshold;
-    if (high) ++s.high_variance;
     s.variance_sum += color_variance[i];
+    const bool inner = plane_inner[i] != 0;
+    const bool high = inner && color_variance[i] > params_.variance_threshold;
+    s.inner += inner ? 1 : 0;
+    s.high_variance += high ? 1 : 0;
     for (size_t m = 0; m < masks.size(); ++m)
-      if (masks[m].mask[i]) ++s.overlap[m], s.overlap_high[m] += high ? 1 : 0;
+      if (masks[m].mask[i]) {
+        ++s.overlap[m];
+        const bool in_mask = inner && (!masks[m].reflective || mask_inner[m][i] != 0);
+        s.overlap_inner[m] += in_mask ? 1 : 0;
+        s.overlap_high[m] += in_mask && high ? 1 : 0;
+      }
   }
   // A plane's mask: a reflective mask that lies mostly on it (>= min_mask_overlap of the mask's
   // pixels: a mirror or a screen on a wall is a part of the wall's plane, and the plane's largest
@@ -113,9 +155,9 @@ IdentificationResult PlaneIdentifier::identify(const IdentificationFrame& frame,
     if (m >= 0) v.label = masks[size_t(m)].label;
     const bool reflective_mask = m >= 0 && masks[size_t(m)].reflective;
     v.candidate = cue_->every_plane_is_candidate() || reflective_mask;
-    // The variance check looks at the region claimed reflective: the plane's pixels inside its
-    // reflective mask when it has one, else all of its pixels.
-    const int64_t region = reflective_mask ? s.overlap[size_t(m)] : s.pixels;
+    // The variance check looks at the region claimed reflective: the plane's interior pixels
+    // inside its reflective mask when it has one, else all of its interior pixels.
+    const int64_t region = reflective_mask ? s.overlap_inner[size_t(m)] : s.inner;
     const int64_t region_high = reflective_mask ? s.overlap_high[size_t(m)] : s.high_variance;
     v.variance_fraction = region > 0 ? float(double(region_high) / double(region)) : 0.0f;
     v.variance_mean = s.pixels > 0 ? float(s.variance_sum / double(s.pixels)) : 0.0f;

@@ -32,6 +32,12 @@ struct IdentificationParams {
   float area_threshold = 0.05f;      // δ_area: fraction of the plane's pixels above δ_v
   float min_mask_overlap = 0.3f;     // a plane takes its largest-overlap mask only when the mask
                                      // covers at least this fraction of the plane's pixels
+  // Pixels closer than this many TSDF voxels (IdentificationFrame::voxel_size, measured on the
+  // image at the pixel's depth) to the border of their plane, or of the reflective mask being
+  // checked, are left out of the variance check: the trilinear C_var of a raycast mixes voxels
+  // across a border, so a thin matte plane beside a mirror (its frame) would otherwise inherit the
+  // mirror's variance, and a colour edge (a whiteboard's rim on a wall) aliases into variance.
+  float variance_border_voxels = 2.0f;
   void validate() const;             // throws std::invalid_argument
 };
 
@@ -42,6 +48,7 @@ struct IdentificationFrame {
   Intrinsics K;
   Eigen::Isometry3f T_wc = Eigen::Isometry3f::Identity();
   int64_t index = 0;                      // frame index
+  float voxel_size = 0;                   // TSDF voxel behind C_var, metres (0 = no border erosion)
 };
 
 struct PlaneVerdict {

@@ -159,7 +159,8 @@ void Session::Impl::identify(const SessionFrame& frame, const Eigen::Isometry3f&
                              DeviceImage<int32_t>& plane_ids, DeviceImage<uint8_t>& mask) {
   const auto t0 = Clock::now();
   const Image<float> cvar = locked_raycast(K, T_wc).color_variance.to_host();
-  IdentificationFrame f{&frame.depth, &frame.color, frame.labels ? &*frame.labels : nullptr, K, T_wc, frame.index};
+  IdentificationFrame f{&frame.depth, &frame.color, frame.labels ? &*frame.labels : nullptr, K, T_wc, frame.index,
+                        config.tsdf.voxel_size};
   if (identifier.cue().name() == "labels" && !frame.labels) f.labels = nullptr;
   IdentificationResult r = identifier.identify(f, cvar);
   plane_ids = DeviceImage<int32_t>::from_host(r.global_map, config.device);

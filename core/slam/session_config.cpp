@@ -201,6 +201,8 @@ std::vector<ConfigField> config_fields(SessionConfig& c) {
   // planes (§4.1.3)
   t.f("planes.variance_threshold", c.planes.variance_threshold, "δ_v on C_var");
   t.f("planes.area_threshold", c.planes.area_threshold, "δ_area");
+  t.f("planes.variance_border_voxels", c.planes.variance_border_voxels,
+      "pixels this many TSDF voxels from a plane's border are left out of the variance check");
   t.i("planes.vote.windows", c.planes.vote.windows, "vote history, windows");
   t.i("planes.vote.min_reflective", c.planes.vote.min_reflective, "windows needed to accept");
   t.f("planes.segmentation.sigma_min", c.planes.segmentation.sigma_min, "σ_min, metres");
