@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 namespace rrg {
@@ -129,12 +130,21 @@ GaussianHost init_gaussians(std::span<const Eigen::Vector3f> points, std::span<c
   return h;
 }
 
-GaussianHost densify_base(const DensifyView& v, const DensifyParams& p, int sh_degree, uint64_t seed) {
+GaussianHost densify_base(const DensifyView& v, const DensifyParams& p, int sh_degree, uint64_t seed,
+                          std::span<const ReflectivePlane> reflective) {
   p.validate();
   check_image(v.C_gt, v.K, "C_gt");
   check_image(v.D_gt, v.K, "D_gt");
   check_image(v.C, v.K, "C");
   check_image(v.W_b, v.K, "W_b");
+  const bool leave = p.base_leaves_reflections && !reflective.empty();
+  std::unordered_set<int32_t> reflective_ids;
+  if (leave) {
+    check_image(v.R, v.K, "R");
+    check_image(v.C_var, v.K, "C_var");
+    check_image(v.I, v.K, "I");
+    for (const ReflectivePlane& pl : reflective) reflective_ids.insert(pl.id);
+  }
   std::vector<Eigen::Vector3f> pts, nrm;
   std::vector<Color> col;
   const Eigen::Matrix3f R_wc = v.T_wc.linear();
@@ -143,6 +153,8 @@ GaussianHost densify_base(const DensifyView& v, const DensifyParams& p, int sh_d
       const float z = (*v.D_gt)(x, y);
       if (!(z > 0)) continue;
       if (!(color_error((*v.C_gt)(x, y), (*v.C)(x, y)) > p.base_error && (*v.W_b)(x, y) < p.base_weight)) continue;
+      if (leave && (*v.R)(x, y) != 0 && (*v.C_var)(x, y) > p.variance && reflective_ids.count((*v.I)(x, y)) > 0)
+        continue;
       if (!(pixel_uniform(seed, int64_t(y) * v.K.width + x) < p.sample_ratio)) continue;
       pts.push_back(v.T_wc * v.K.unproject(float(x), float(y), z));
       nrm.push_back(R_wc * depth_normal(*v.D_gt, v.K, x, y));

@@ -52,6 +52,7 @@ struct DensifyParams {
   float flatten = 0.1f;              // normal-axis scale / tangential scale
   float init_opacity = 0.5f;
   bool reflection_residual_color = false;  // reflection colour max(C_gt − C_b, 0) instead of C_gt
+  bool base_leaves_reflections = false;    // see densify_base (off: on mirror_room it cost 0.4 dB)
   void validate() const;             // throws std::invalid_argument naming the bad field
 };
 
@@ -70,7 +71,11 @@ struct DensifyView {
   const Image<int32_t>* I = nullptr;    // plane ids
 };
 
-GaussianHost densify_base(const DensifyView& view, const DensifyParams& params, int sh_degree, uint64_t seed);
+// With `reflective` planes given (and params.base_leaves_reflections), the pixels that the
+// reflection set may take (R = 1 on one of those planes and C_var > δ_v: temporally varying
+// appearance on a reflective plane) get no base Gaussians: their error is the reflection's to fit.
+GaussianHost densify_base(const DensifyView& view, const DensifyParams& params, int sh_degree, uint64_t seed,
+                          std::span<const ReflectivePlane> reflective = {});
 GaussianHost densify_reflection(const DensifyView& view, std::span<const ReflectivePlane> planes,
                                 const DensifyParams& params, int sh_degree, uint64_t seed);
 

@@ -257,7 +257,8 @@ MappingStats GaussianMapper::step(const MappingContext& ctx) {
     v.C_var = &f.C_var;
     v.I = &I;
     const uint64_t fseed = mix(seed ^ mix(uint64_t(f.frame->index)));
-    const GaussianHost nb = densify_base(v, params_.densify, params_.sh_degree, fseed);
+    const GaussianHost nb = densify_base(v, params_.densify, params_.sh_degree, fseed,
+                                         reflections ? std::span<const ReflectivePlane>(ctx.planes) : std::span<const ReflectivePlane>{});
     append_to(base_, adam_base_, nb);
     st.base_added += int64_t(nb.size());
     if (reflections) {

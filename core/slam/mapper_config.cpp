@@ -41,6 +41,10 @@ void add_mapper_config_fields(ConfigTable& t, MapperParams& p) {
   t.f("densify.reflection_near", p.densify.reflection_near, "first sample past the plane, metres");
   t.f("densify.reflection_far", p.densify.reflection_far, "last sample past the plane, metres");
   t.f("densify.max_init_scale", p.densify.max_init_scale, "cap of the initial scale, metres");
+  t.b("densify.base_leaves_reflections", p.densify.base_leaves_reflections,
+      "no base Gaussians where the reflection set may densify (R = 1, C_var > δ_v on a reflective plane)");
+  t.b("densify.reflection_residual_color", p.densify.reflection_residual_color,
+      "reflection colour from max(C_gt − C_b, 0) instead of C_gt");
   t.f("prune.base.min_opacity", p.prune_base.min_opacity, "base: prune below this opacity");
   t.f("prune.base.min_scale", p.prune_base.min_scale, "base: prune below this scale, metres");
   t.f("prune.base.max_scale", p.prune_base.max_scale, "base: prune above this scale, metres");

@@ -70,6 +70,26 @@ TEST(Densify, BaseCandidatesFollowErrorAndWeightRules) {
   }
 }
 
+// base_leaves_reflections: pixels the reflection set may take (R = 1, C_var > δ_v, on a given
+// reflective plane) get no base Gaussian; every other candidate still does; off = the plain rule.
+TEST(Densify, BaseLeavesReflectionCandidatesWhenAsked) {
+  WallView w;
+  for (auto& c : w.C.pixels()) c = Color(0.8f, 0.4f, 0.0f);       // every pixel a base candidate
+  for (int y = 0; y < 24; ++y)
+    for (int x = 0; x < 8; ++x) w.R(x, y) = 0;                     // columns 0-7: not reflective
+  for (int y = 0; y < 24; ++y) w.C_var(8, y) = 0.005f;             // column 8: steady colour
+  for (int y = 0; y < 24; ++y) w.I(9, y) = 5;                      // column 9: another plane
+  const std::vector<ReflectivePlane> planes{{4, Eigen::Vector4f(0, 0, -1, 2)}};
+  DensifyParams p;
+  p.sample_ratio = 1.0f;
+  EXPECT_EQ(densify_base(w.view(), p, 0, 3, planes).size(), size_t(32 * 24));  // off by default
+  p.base_leaves_reflections = true;
+  EXPECT_EQ(densify_base(w.view(), p, 0, 3).size(), size_t(32 * 24));          // no planes given
+  const GaussianHost g = densify_base(w.view(), p, 0, 3, planes);
+  EXPECT_EQ(g.size(), size_t(10 * 24));  // columns 0-9 only
+  for (const auto& m : g.means) EXPECT_LT(w.K.project(m).x(), 9.5f);
+}
+
 TEST(Densify, ScaleFromThreeNearestNewPoints) {
   // Close wall: 0.2 m at f = 40 -> 5 mm between pixels; 3 nearest at 5, 5, 5 mm.
   WallView w;

@@ -4,12 +4,14 @@
 #include "core/eval/image_metrics.h"
 #include "core/io/image_io.h"
 #include "core/slam/mapper.h"
+#include "core/slam/session_config.h"
 #include "tests/slam/mapper_scene.h"
 
 #include <gtest/gtest.h>
 #include <omp.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <thread>
@@ -33,6 +35,27 @@ bool verbose() { return std::getenv("RRG_MAPPER_VERBOSE") != nullptr; }
 int env_int(const char* name, int fallback) {
   const char* v = std::getenv(name);
   return v ? std::atoi(v) : fallback;
+}
+
+// Mapper fields from $RRG_MAPPER_SET ("name=value;name=value", the names of `mapping.*` without
+// the prefix), for documented experiments with the ablation; unset = the paper's defaults.
+void apply_env_overrides(MapperParams& p) {
+  const char* env = std::getenv("RRG_MAPPER_SET");
+  if (!env) return;
+  ConfigTable t;
+  add_mapper_config_fields(t, p);
+  std::string all = env;
+  for (size_t start = 0; start < all.size();) {
+    const size_t end = std::min(all.find(';', start), all.size());
+    const std::string a = all.substr(start, end - start);
+    start = end + 1;
+    const size_t eq = a.find('=');
+    if (eq == std::string::npos) throw std::invalid_argument("RRG_MAPPER_SET: '" + a + "' is not name=value");
+    const auto it = std::find_if(t.fields.begin(), t.fields.end(), [&](const ConfigField& f) { return f.name == a.substr(0, eq); });
+    if (it == t.fields.end()) throw std::invalid_argument("RRG_MAPPER_SET: no mapper field '" + a.substr(0, eq) + "'");
+    it->set(a.substr(eq + 1));
+    std::printf("[ ablation ] %s\n", a.c_str());
+  }
 }
 
 TEST(Mapper, StepsAreDeterministicAndKeepTheBooks) {
@@ -150,6 +173,7 @@ TEST(Mapper, ReflectionsImproveTheMirrorOnNovelViews) {
   ASSERT_EQ(s.planes.size(), 1u);
   auto map = [&](bool reflections) {
     MapperParams p;
+    apply_env_overrides(p);
     p.reflections = reflections;
     auto m = std::make_unique<GaussianMapper>(p, s.K, Device::cpu());
     for (size_t i = 0; i < s.frames.size(); ++i) {
