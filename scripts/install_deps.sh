@@ -18,6 +18,8 @@ PACKAGES=(
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc  # the service, remote semantic cue
   libcpp-httplib-dev         # the service's Prometheus endpoint
   libssl-dev                 # the service's tokens (RAND_bytes, SHA-256)
+  nginx                      # tests/deploy: the session-affine gRPC proxy in front of 3 servers
+  chromium                   # the browser viewer's end-to-end test (tests/web, headless)
 )
 
 missing=()

@@ -36,6 +36,7 @@ class FrameStream final : public grpc::ServerBidiReactor<v1::Frame, v1::FrameRes
  public:
   FrameStream(grpc::CallbackServerContext* ctx, SessionManager& manager, Metrics& metrics)
       : ctx_(ctx), manager_(manager), metrics_(metrics), sink_(std::make_shared<StreamSink>(this)) {
+    tag_server(ctx, manager);
     const std::string header = session_header(*ctx);
     if (!header.empty()) {
       try {

@@ -1,6 +1,7 @@
 #include "server/server.h"
 
 #include "core/io/atomic_file.h"
+#include "server/http_api.h"
 #include "server/metrics.h"
 #include "server/service.h"
 
@@ -49,6 +50,7 @@ int run_server(const ServerOptions& o) {
   sigemptyset(&signals);
   sigaddset(&signals, SIGINT);
   sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGUSR1);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
   Metrics metrics;
@@ -71,15 +73,19 @@ int run_server(const ServerOptions& o) {
   std::unique_ptr<MetricsHttpServer> http;
   if (o.metrics_port >= 0)
     http = std::make_unique<MetricsHttpServer>(o.metrics_port, [&] { return metrics.prometheus_text(manager.gauges()); });
+  std::unique_ptr<HttpApiServer> http_api;
+  if (o.http_port >= 0) http_api = std::make_unique<HttpApiServer>(HttpApiOptions{o.http_port, o.http_port_file, o.viewer_dir}, manager);
 
   grpc::HealthCheckServiceInterface* health = server->GetHealthCheckService();
   const std::string service_name = v1::SessionService::service_full_name();
   health->SetServingStatus(true);
   health->SetServingStatus(service_name, manager.has_capacity());
+  health->SetServingStatus("liveness", true);
   std::atomic<bool> stopping{false};
-  std::thread health_updater([&] {  // capacity changes as sessions come and go
+  std::thread health_updater([&] {  // capacity changes as sessions come and go; draining is final
     while (!stopping) {
       health->SetServingStatus(service_name, manager.has_capacity());
+      if (manager.draining()) health->SetServingStatus("", false);
       for (int i = 0; i < 10 && !stopping; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
     }
   });
@@ -88,7 +94,7 @@ int run_server(const ServerOptions& o) {
     io::write_atomically(o.port_file, [&](const std::filesystem::path& tmp) {
       std::ofstream(tmp) << port << "\n";
     });
-  spdlog::info("serve: listening on port {} ({}; max message {} bytes; {} sessions max; snapshots {}{}{})", port,
+  spdlog::info("serve: server {} listening on port {} ({}; max message {} bytes; {} sessions max; snapshots {}{}{})", o.manager.server_name, port,
                o.tls_cert.empty() ? "insecure" : "TLS", o.max_message_bytes, o.manager.max_sessions,
                o.manager.snapshot_dir.empty() ? "off" : o.manager.snapshot_dir.string(),
                o.manager.admin_key.empty() ? "" : "; admin key set",
@@ -100,8 +106,20 @@ int run_server(const ServerOptions& o) {
   );
 
   int sig = 0;
-  sigwait(&signals, &sig);
+  std::thread drainer;
+  while (true) {
+    sigwait(&signals, &sig);
+    if (sig != SIGUSR1) break;
+    spdlog::info("serve: SIGUSR1 received, draining");
+    health->SetServingStatus("", false);
+    health->SetServingStatus(service_name, false);
+    if (!drainer.joinable()) drainer = std::thread([&manager] { manager.drain(); });  // sigwait stays responsive
+  }
   spdlog::info("serve: {} received, shutting down", sig == SIGINT ? "SIGINT" : "SIGTERM");
+  health->SetServingStatus("", false);
+  health->SetServingStatus(service_name, false);
+  manager.drain();  // new calls on the sessions now say they were drained, not "not found"
+  if (drainer.joinable()) drainer.join();
   stopping = true;
   health_updater.join();
   health->Shutdown();  // health checks now answer NOT_SERVING
@@ -110,6 +128,7 @@ int run_server(const ServerOptions& o) {
   // New calls are refused from here; sessions are drained and snapshotted while the calls in
   // flight finish (closing a session also ends its watchers), then a second pass catches a
   // session created by a call that was already running.
+  http_api.reset();  // ends the viewer's event streams
   std::thread stopper([&] { server->Shutdown(deadline); });
   manager.shutdown();
   stopper.join();

@@ -24,7 +24,8 @@ constexpr size_t kMaxChunk = 4 << 20;
 constexpr int64_t kMaxRenderPixels = int64_t(4096) * 4096;
 
 template <class F>
-grpc::ServerUnaryReactor* unary(grpc::CallbackServerContext* ctx, const char* name, F&& f) {
+grpc::ServerUnaryReactor* unary(grpc::CallbackServerContext* ctx, const SessionManager& manager, const char* name, F&& f) {
+  tag_server(ctx, manager);
   grpc::ServerUnaryReactor* reactor = ctx->DefaultReactor();
   grpc::Status status = grpc::Status::OK;
   try {
@@ -53,19 +54,23 @@ std::string ply_bytes(const GaussianHost& g, bool with_plane_ids) {
 
 }  // namespace
 
+void tag_server(grpc::CallbackServerContext* ctx, const SessionManager& manager) {
+  ctx->AddInitialMetadata("x-rrg-server", manager.options().server_name);
+}
+
 grpc::ServerUnaryReactor* SessionServiceImpl::Create(grpc::CallbackServerContext* ctx, const v1::CreateSessionRequest* req,
                                                      v1::CreateSessionResponse* resp) {
-  return unary(ctx, "Create", [&] { *resp = manager_.create(*req); });
+  return unary(ctx, manager_, "Create", [&] { *resp = manager_.create(*ctx, *req); });
 }
 
 grpc::ServerUnaryReactor* SessionServiceImpl::Get(grpc::CallbackServerContext* ctx, const v1::GetSessionRequest* req,
                                                   v1::SessionInfo* resp) {
-  return unary(ctx, "Get", [&] { *resp = manager_.authorize(*ctx, req->session_id())->info(); });
+  return unary(ctx, manager_, "Get", [&] { *resp = manager_.authorize(*ctx, req->session_id())->info(); });
 }
 
 grpc::ServerUnaryReactor* SessionServiceImpl::List(grpc::CallbackServerContext* ctx, const v1::ListSessionsRequest*,
                                                    v1::ListSessionsResponse* resp) {
-  return unary(ctx, "List", [&] {
+  return unary(ctx, manager_, "List", [&] {
     manager_.require_admin(*ctx);
     for (const auto& s : manager_.list()) *resp->add_sessions() = s->info();
   });
@@ -73,7 +78,7 @@ grpc::ServerUnaryReactor* SessionServiceImpl::List(grpc::CallbackServerContext* 
 
 grpc::ServerUnaryReactor* SessionServiceImpl::Close(grpc::CallbackServerContext* ctx, const v1::CloseSessionRequest* req,
                                                     v1::CloseSessionResponse* resp) {
-  return unary(ctx, "Close", [&] {
+  return unary(ctx, manager_, "Close", [&] {
     const auto s = manager_.authorize(*ctx, req->session_id());
     *resp = manager_.close(s->meta().id, req->save());
   });
@@ -81,14 +86,22 @@ grpc::ServerUnaryReactor* SessionServiceImpl::Close(grpc::CallbackServerContext*
 
 grpc::ServerUnaryReactor* SessionServiceImpl::Save(grpc::CallbackServerContext* ctx, const v1::SaveSessionRequest* req,
                                                    v1::SaveSessionResponse* resp) {
-  return unary(ctx, "Save", [&] { *resp = manager_.save(*manager_.authorize(*ctx, req->session_id())); });
+  return unary(ctx, manager_, "Save", [&] { *resp = manager_.save(*manager_.authorize(*ctx, req->session_id())); });
 }
 
 grpc::ServerUnaryReactor* SessionServiceImpl::Load(grpc::CallbackServerContext* ctx, const v1::LoadSessionRequest* req,
                                                    v1::CreateSessionResponse* resp) {
-  return unary(ctx, "Load", [&] {
+  return unary(ctx, manager_, "Load", [&] {
     const std::string id = req->session_id().empty() ? session_header(*ctx) : req->session_id();
     *resp = manager_.load(*ctx, id);
+  });
+}
+
+grpc::ServerUnaryReactor* SessionServiceImpl::Drain(grpc::CallbackServerContext* ctx, const v1::DrainRequest*,
+                                                    v1::DrainResponse* resp) {
+  return unary(ctx, manager_, "Drain", [&] {
+    manager_.require_admin(*ctx);
+    *resp = manager_.drain();
   });
 }
 
@@ -98,7 +111,7 @@ grpc::ServerBidiReactor<v1::Frame, v1::FrameResult>* SessionServiceImpl::StreamF
 
 grpc::ServerUnaryReactor* SessionServiceImpl::RenderView(grpc::CallbackServerContext* ctx, const v1::RenderViewRequest* req,
                                                          v1::RenderViewResponse* resp) {
-  return unary(ctx, "RenderView", [&] {
+  return unary(ctx, manager_, "RenderView", [&] {
     const auto s = manager_.authorize(*ctx, req->session_id());
     if (!req->has_pose()) throw std::invalid_argument("pose: missing");
     const Eigen::Isometry3f T = service::from_proto(req->pose(), "pose");
@@ -125,6 +138,7 @@ grpc::ServerUnaryReactor* SessionServiceImpl::RenderView(grpc::CallbackServerCon
 
 grpc::ServerWriteReactor<v1::DataChunk>* SessionServiceImpl::GetMesh(grpc::CallbackServerContext* ctx,
                                                                      const v1::GetMeshRequest* req) {
+  tag_server(ctx, manager_);
   try {
     const auto s = manager_.authorize(*ctx, req->session_id());
     v1::DataChunk header;
@@ -145,6 +159,7 @@ grpc::ServerWriteReactor<v1::DataChunk>* SessionServiceImpl::GetMesh(grpc::Callb
 
 grpc::ServerWriteReactor<v1::DataChunk>* SessionServiceImpl::GetGaussians(grpc::CallbackServerContext* ctx,
                                                                           const v1::GetGaussiansRequest* req) {
+  tag_server(ctx, manager_);
   try {
     const auto s = manager_.authorize(*ctx, req->session_id());
     const bool reflection = req->set() == v1::GetGaussiansRequest::REFLECTION;
@@ -174,6 +189,7 @@ grpc::ServerWriteReactor<v1::DataChunk>* SessionServiceImpl::GetGaussians(grpc::
 
 grpc::ServerWriteReactor<v1::SessionEvent>* SessionServiceImpl::WatchSession(grpc::CallbackServerContext* ctx,
                                                                              const v1::WatchSessionRequest* req) {
+  tag_server(ctx, manager_);
   try {
     return make_event_writer(manager_.authorize(*ctx, req->session_id()));
   } catch (...) {

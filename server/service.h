@@ -2,7 +2,8 @@
 // rrg.v1.SessionService on gRPC's callback API. Unary calls run on gRPC's callback threads and
 // call into the SessionManager; StreamFrames feeds each session's worker queue and writes the
 // results back in order; GetMesh / GetGaussians stream one encoded file in chunks; WatchSession
-// forwards a session's events. Every handler maps exceptions to statuses (status_error.h).
+// forwards a session's events. Every handler maps exceptions to statuses (status_error.h) and
+// names the answering server in the initial metadata `x-rrg-server` (what proxy tests check).
 #include "rrg/v1/service.grpc.pb.h"
 #include "server/metrics.h"
 #include "server/session_manager.h"
@@ -25,6 +26,8 @@ class SessionServiceImpl final : public v1::SessionService::CallbackService {
                                  v1::SaveSessionResponse* resp) override;
   grpc::ServerUnaryReactor* Load(grpc::CallbackServerContext* ctx, const v1::LoadSessionRequest* req,
                                  v1::CreateSessionResponse* resp) override;
+  grpc::ServerUnaryReactor* Drain(grpc::CallbackServerContext* ctx, const v1::DrainRequest* req,
+                                  v1::DrainResponse* resp) override;
   grpc::ServerBidiReactor<v1::Frame, v1::FrameResult>* StreamFrames(grpc::CallbackServerContext* ctx) override;
   grpc::ServerUnaryReactor* RenderView(grpc::CallbackServerContext* ctx, const v1::RenderViewRequest* req,
                                        v1::RenderViewResponse* resp) override;
@@ -39,6 +42,9 @@ class SessionServiceImpl final : public v1::SessionService::CallbackService {
   SessionManager& manager_;
   Metrics& metrics_;
 };
+
+// Adds `x-rrg-server: <server name>` to the call's initial metadata (before anything is sent).
+void tag_server(grpc::CallbackServerContext* ctx, const SessionManager& manager);
 
 // The reactor of one StreamFrames call (server/frame_stream.cpp).
 grpc::ServerBidiReactor<v1::Frame, v1::FrameResult>* make_frame_stream(grpc::CallbackServerContext* ctx,

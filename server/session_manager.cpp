@@ -18,6 +18,14 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// A client-proposed id: [a-z0-9-]{4,64} (safe as a file name, a header and a hash key).
+bool valid_proposed_id(const std::string& id) {
+  if (id.size() < 4 || id.size() > 64) return false;
+  for (char c : id)
+    if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-')) return false;
+  return true;
+}
+
 bool valid_id(const std::string& id) {
   if (id.empty() || id.size() > 64) return false;
   for (char c : id)
@@ -101,6 +109,7 @@ void SessionManager::admit(size_t extra) const {
 }
 
 bool SessionManager::has_capacity() const {
+  if (draining_) return false;
   std::lock_guard lock(mutex_);
   try {
     admit(1);
@@ -110,7 +119,16 @@ bool SessionManager::has_capacity() const {
   }
 }
 
-v1::CreateSessionResponse SessionManager::create(const v1::CreateSessionRequest& r) {
+v1::CreateSessionResponse SessionManager::create(const grpc::ServerContextBase& ctx, const v1::CreateSessionRequest& r) {
+  if (draining_)
+    throw StatusError(grpc::StatusCode::UNAVAILABLE, "create: server " + options_.server_name +
+                                                         " is draining; create the session on another server");
+  const std::string header = session_header(ctx);
+  if (!r.session_id().empty() && !header.empty() && header != r.session_id())
+    throw std::invalid_argument("session_id: '" + r.session_id() + "' but the x-rrg-session header says '" + header + "'");
+  const std::string proposed = r.session_id().empty() ? header : r.session_id();
+  if (!proposed.empty() && !valid_proposed_id(proposed))
+    throw std::invalid_argument("session_id: '" + proposed + "' must be 4 to 64 characters of [a-z0-9-]");
   if (!r.has_intrinsics()) throw std::invalid_argument("intrinsics: missing");
   io::validate_intrinsics(service::from_proto(r.intrinsics()));
   const float depth_scale = r.depth_scale() == 0.0f ? 1000.0f : r.depth_scale();
@@ -122,10 +140,18 @@ v1::CreateSessionResponse SessionManager::create(const v1::CreateSessionRequest&
   if (r.name().size() > 256) throw std::invalid_argument("name: longer than 256 characters");
   SessionConfig config = make_config(r, options_);
 
+  const std::string id = proposed.empty() ? new_session_id() : proposed;
   {
     std::lock_guard lock(mutex_);
+    if (sessions_.count(id) || reserved_ids_.count(id))
+      throw StatusError(grpc::StatusCode::ALREADY_EXISTS, "session_id: " + id + " is taken (live on server " +
+                                                              options_.server_name + ")");
+    if (!options_.snapshot_dir.empty() && fs::exists(meta_file(id)))
+      throw StatusError(grpc::StatusCode::ALREADY_EXISTS, "session_id: " + id +
+                                                              " is taken (saved in the snapshot folder: Load it, or choose another id)");
     admit(1);
     ++pending_;
+    reserved_ids_.insert(id);
   }
   std::shared_ptr<ManagedSession> managed;
   v1::CreateSessionResponse out;
@@ -136,7 +162,7 @@ v1::CreateSessionResponse SessionManager::create(const v1::CreateSessionRequest&
       throw exhausted("admission: a new session takes " + std::to_string(st.device_bytes + st.host_bytes) +
                       " bytes, over the per-session budget of " + std::to_string(options_.session_memory_budget));
     SessionMeta meta;
-    meta.id = new_session_id();
+    meta.id = id;
     meta.name = r.name();
     const std::string token = new_token();
     meta.token_sha256 = sha256_hex(token);
@@ -149,11 +175,14 @@ v1::CreateSessionResponse SessionManager::create(const v1::CreateSessionRequest&
   } catch (...) {
     std::lock_guard lock(mutex_);
     --pending_;
+    reserved_ids_.erase(id);
     throw;
   }
   {
     std::lock_guard lock(mutex_);
     --pending_;
+    reserved_ids_.erase(id);
+    drained_.erase(id);
     sessions_[managed->meta().id] = managed;
   }
   metrics_.session_created();
@@ -166,8 +195,14 @@ v1::CreateSessionResponse SessionManager::create(const v1::CreateSessionRequest&
 std::shared_ptr<ManagedSession> SessionManager::find(const std::string& id) const {
   std::lock_guard lock(mutex_);
   const auto it = sessions_.find(id);
-  if (it == sessions_.end()) throw not_found("session " + id + " not found");
-  return it->second;
+  if (it != sessions_.end()) return it->second;
+  const auto d = drained_.find(id);
+  if (d != drained_.end())
+    throw not_found("not found: server " + options_.server_name + " drained session " + id +
+                    (d->second ? " and saved it to the snapshot folder: Load it on another server sharing that folder"
+                               : " but could not save it (see the server's log)"));
+  throw not_found("not found: server " + options_.server_name + " does not hold session " + id +
+                  "; it may be on another server or saved: Load it");
 }
 
 std::shared_ptr<ManagedSession> SessionManager::authorize(const grpc::ServerContextBase& ctx,
@@ -271,9 +306,14 @@ v1::CreateSessionResponse SessionManager::load(const grpc::ServerContextBase& ct
     throw unauthenticated("authorization: wrong token for session " + id);
   {
     std::lock_guard lock(mutex_);
-    if (sessions_.count(id)) throw StatusError(grpc::StatusCode::ALREADY_EXISTS, "load: session " + id + " is live");
+    if (draining_)
+      throw StatusError(grpc::StatusCode::UNAVAILABLE, "load: server " + options_.server_name +
+                                                           " is draining; load the session on another server");
+    if (sessions_.count(id) || reserved_ids_.count(id))
+      throw StatusError(grpc::StatusCode::ALREADY_EXISTS, "load: session " + id + " is live on server " + options_.server_name);
     admit(1);
     ++pending_;
+    reserved_ids_.insert(id);
   }
   v1::CreateSessionResponse out;
   std::shared_ptr<ManagedSession> managed;
@@ -296,11 +336,14 @@ v1::CreateSessionResponse SessionManager::load(const grpc::ServerContextBase& ct
   } catch (...) {
     std::lock_guard lock(mutex_);
     --pending_;
+    reserved_ids_.erase(id);
     throw;
   }
   {
     std::lock_guard lock(mutex_);
     --pending_;
+    reserved_ids_.erase(id);
+    drained_.erase(id);
     sessions_[id] = managed;
   }
   metrics_.session_created();
@@ -334,6 +377,48 @@ void SessionManager::shutdown() {
       spdlog::error("session {}: shutdown snapshot failed: {}", s->meta().id, e.what());
     }
   }
+}
+
+v1::DrainResponse SessionManager::drain() {
+  std::lock_guard drain_lock(drain_mutex_);
+  draining_ = true;
+  v1::DrainResponse out;
+  out.set_server(options_.server_name);
+  // A Create / Load admitted just before draining_ was set may still be constructing its session.
+  for (int i = 0; i < 600; ++i) {
+    {
+      std::lock_guard lock(mutex_);
+      if (pending_ == 0) break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  for (const auto& s : list()) {
+    const std::string id = s->meta().id;
+    {
+      std::lock_guard lock(mutex_);
+      drained_[id] = true;  // read only once the session has left sessions_
+    }
+    try {
+      const bool can_save = !options_.snapshot_dir.empty();
+      close(id, can_save);  // queued frames are processed first
+      if (can_save) {
+        out.add_saved(id);
+      } else {
+        out.add_failed(id + ": not saved: the server has no snapshot folder (--snapshot-dir)");
+        std::lock_guard lock(mutex_);
+        drained_[id] = false;
+      }
+    } catch (const std::exception& e) {
+      out.add_failed(id + ": " + e.what());
+      spdlog::error("drain: session {}: snapshot failed: {}; freeing it", id, e.what());
+      std::lock_guard lock(mutex_);
+      drained_[id] = false;
+      sessions_.erase(id);
+    }
+  }
+  spdlog::info("drain: server {} drained: {} sessions saved, {} failed", options_.server_name, out.saved_size(),
+               out.failed_size());
+  return out;
 }
 
 std::string SessionManager::gauges() const {

@@ -3,7 +3,8 @@
 // memory budgets -> RESOURCE_EXHAUSTED with the reason), lookup with bearer-token auth, Close,
 // Save / Load to the snapshot folder (Session::save plus a JSON sidecar of the service's own
 // metadata, both written atomically), the idle timeout (snapshot, then free) and the final
-// snapshot of every session at shutdown.
+// snapshot of every session at shutdown, and draining (issue #11): refuse new sessions, snapshot
+// and free every session, and remember which were drained so later calls say where they went.
 #include "core/common/device.h"
 #include "rrg/v1/service.pb.h"
 #include "server/managed_session.h"
@@ -11,11 +12,13 @@
 
 #include <grpcpp/server_context.h>
 
+#include <atomic>
 #include <condition_variable>
 #include <filesystem>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -33,6 +36,7 @@ struct ManagerOptions {
   Device device;                     // where sessions run
   std::string admin_key;             // empty = no admin key
   std::string segmenter_address;     // for sessions whose config asks for semantics = remote
+  std::string server_name = "rrg";   // named in errors and sent as x-rrg-server (rrg serve --name)
 };
 
 class SessionManager {
@@ -40,7 +44,10 @@ class SessionManager {
   SessionManager(ManagerOptions options, Metrics& metrics);
   ~SessionManager();  // stops the idle reaper; sessions are freed without snapshots (see shutdown)
 
-  v1::CreateSessionResponse create(const v1::CreateSessionRequest& request);
+  // The id is request.session_id, else the x-rrg-session header, else a random one; a proposed
+  // id must match [a-z0-9-]{4,64} and be neither live nor saved (ALREADY_EXISTS).
+  // UNAVAILABLE while draining.
+  v1::CreateSessionResponse create(const grpc::ServerContextBase& ctx, const v1::CreateSessionRequest& request);
   // The session `id` (or the x-rrg-session header when id is empty) if the call's bearer token is
   // its token or the admin key. NOT_FOUND / UNAUTHENTICATED / INVALID_ARGUMENT (no id) otherwise.
   std::shared_ptr<ManagedSession> authorize(const grpc::ServerContextBase& ctx, const std::string& id) const;
@@ -58,6 +65,11 @@ class SessionManager {
   std::string gauges() const;  // Prometheus lines: sessions, memory, queues
   // Snapshots (when a snapshot folder is set) and frees every session; queued frames are processed.
   void shutdown();
+  // From now on Create / Load answer UNAVAILABLE and has_capacity() is false; then every session
+  // is snapshotted (queued frames processed first) and freed. Calls on a drained session get
+  // NOT_FOUND saying it was drained and can be loaded elsewhere. Idempotent.
+  v1::DrainResponse drain();
+  bool draining() const { return draining_.load(); }
   const ManagerOptions& options() const { return options_; }
 
  private:
@@ -73,7 +85,11 @@ class SessionManager {
   Metrics& metrics_;
   mutable std::mutex mutex_;
   std::map<std::string, std::shared_ptr<ManagedSession>> sessions_;
+  std::map<std::string, bool> drained_;  // id -> snapshot written
+  std::set<std::string> reserved_ids_;   // ids of sessions being constructed (Create / Load)
   size_t pending_ = 0;  // admitted, being constructed
+  std::atomic<bool> draining_{false};
+  std::mutex drain_mutex_;  // one drain at a time
 
   std::mutex reaper_mutex_;
   std::condition_variable reaper_cv_;

@@ -20,7 +20,7 @@ void register_planes_command(CLI::App& app);   // rrg planes (reflective plane i
 void register_serve_command(CLI::App& app);     // rrg serve
 void register_stream_command(CLI::App& app);    // rrg stream
 void register_fetch_commands(CLI::App& app);    // rrg render | mesh | gaussians
-void register_session_commands(CLI::App& app);  // rrg sessions | save | load
+void register_session_commands(CLI::App& app);  // rrg sessions | save | load | drain | health
 void register_run_command(CLI::App& app);      // rrg run (the whole pipeline on a dataset, with evaluation)
 
 }  // namespace rrg::cli

@@ -3,9 +3,12 @@
 
 #if RRG_WITH_GRPC
 #include "core/common/device.h"
+#include "server/http_api.h"
 #include "server/server.h"
 
 #include <spdlog/spdlog.h>
+
+#include <unistd.h>
 
 #include <cstdlib>
 #include <memory>
@@ -21,6 +24,8 @@ void register_serve_command(CLI::App& app) {
   auto log_json = std::make_shared<bool>(false);
   auto max_sessions = std::make_shared<size_t>(16), queue = std::make_shared<size_t>(8);
   cmd->add_option("--address", o->address, "listen address HOST:PORT (port 0: any free port)")->capture_default_str();
+  auto name = std::make_shared<std::string>();
+  cmd->add_option("--name", *name, "server name sent as x-rrg-server and used in errors (default: host name)");
   cmd->add_option("--port-file", o->port_file, "write the bound port to this file once serving");
   cmd->add_option("--device", *device, "cpu | cuda | cuda:N | auto: where sessions run")->capture_default_str();
   cmd->add_option("--max-sessions", *max_sessions, "admission: live sessions at most")->capture_default_str();
@@ -36,16 +41,25 @@ void register_serve_command(CLI::App& app) {
   cmd->add_option("--max-message-mb", *max_message_mb, "largest message accepted or sent, MiB")->capture_default_str();
   cmd->add_option("--metrics-port", o->metrics_port, "Prometheus text endpoint port (-1 = off, 0 = any)")->capture_default_str();
   cmd->add_option("--shutdown-grace", o->shutdown_grace_s, "seconds in-flight calls get at shutdown")->capture_default_str();
+  cmd->add_option("--http-port", o->http_port, "browser viewer + HTTP API port (-1 = off, 0 = any; docs/viewer.md)")->capture_default_str();
+  cmd->add_option("--http-port-file", o->http_port_file, "write the bound HTTP port to this file once serving");
+  cmd->add_option("--viewer-dir", o->viewer_dir, "the built viewer (default: web_viewer/dist of the source tree, if built)");
   cmd->add_flag("--log-json", *log_json, "one JSON object per log line (time, level, message)");
   cmd->callback([=] {
     if (*log_json) spdlog::set_pattern(R"({"time":"%Y-%m-%dT%H:%M:%S.%f%z","level":"%l","thread":%t,"msg":"%v"})");
     server::ServerOptions opts = *o;
+    opts.manager.server_name = *name;
+    if (opts.manager.server_name.empty()) {
+      char host[256] = {};
+      opts.manager.server_name = ::gethostname(host, sizeof(host) - 1) == 0 && host[0] != '\0' ? host : "rrg";
+    }
     opts.manager.device = parse_device(*device);
     opts.manager.max_sessions = *max_sessions;
     opts.manager.default_queue = *queue;
     opts.manager.session_memory_budget = size_t(*session_mb * 1024.0 * 1024.0);
     opts.manager.total_memory_budget = size_t(*total_mb * 1024.0 * 1024.0);
     opts.max_message_bytes = int(*max_message_mb * 1024.0 * 1024.0);
+    if (opts.viewer_dir.empty()) opts.viewer_dir = server::default_viewer_dir();
     if (opts.manager.admin_key.empty())
       if (const char* env = std::getenv("RRG_ADMIN_KEY")) opts.manager.admin_key = env;
     server::run_server(opts);

@@ -1,8 +1,10 @@
-// rrg sessions | save | load: list a server's sessions, snapshot one, restore one.
+// rrg sessions | save | load | drain | health: list a server's sessions, snapshot one, restore one,
+// drain a server (docs/deploy.md), ask its health service (the container HEALTHCHECK).
 #include "client/commands/command.h"
 
 #if RRG_WITH_GRPC
 #include "client/commands/service_common.h"
+#include "client/lib/health_check.h"
 #include "client/lib/proto_convert.h"
 
 #include <cstdio>
@@ -10,6 +12,14 @@
 #include <memory>
 
 namespace rrg::cli {
+
+namespace {
+std::string admin_key_or_env(const std::string& flag) {
+  if (!flag.empty()) return flag;
+  const char* env = std::getenv("RRG_ADMIN_KEY");
+  return env ? env : "";
+}
+}  // namespace
 
 void register_session_commands(CLI::App& app) {
   {
@@ -19,10 +29,7 @@ void register_session_commands(CLI::App& app) {
     f->add(*cmd, false);
     cmd->add_option("--admin-key", *admin, "the server's admin key (default: $RRG_ADMIN_KEY)");
     cmd->callback([=] {
-      std::string key = *admin;
-      if (key.empty())
-        if (const char* env = std::getenv("RRG_ADMIN_KEY")) key = env;
-      const auto list = f->client().list(key);
+      const auto list = f->client().list(admin_key_or_env(*admin));
       std::printf("%-18s %-20s %8s %8s %8s %10s %10s %12s %8s\n", "session", "name", "frames", "dropped", "state",
                   "map", "gaussians", "memory MiB", "idle s");
       for (const auto& s : list.sessions())
@@ -32,6 +39,36 @@ void register_session_commands(CLI::App& app) {
                     (unsigned long long)s.map_version(),
                     (unsigned long long)(s.base_gaussians() + s.reflection_gaussians()),
                     double(s.device_bytes() + s.host_bytes()) / (1024.0 * 1024.0), s.idle_seconds());
+    });
+  }
+  {
+    auto* cmd = app.add_subcommand("drain", "drain a server: refuse new sessions, snapshot and free every session");
+    auto f = std::make_shared<ServiceFlags>();
+    auto admin = std::make_shared<std::string>();
+    f->add(*cmd, false);
+    cmd->add_option("--admin-key", *admin, "the server's admin key (default: $RRG_ADMIN_KEY)");
+    cmd->callback([=] {
+      // Address the server itself (not a proxy): Drain acts on whichever server answers.
+      const auto r = f->client().drain(admin_key_or_env(*admin));
+      std::printf("server %s drained: %d sessions saved, %d failed\n", r.server().c_str(), r.saved_size(), r.failed_size());
+      for (const auto& id : r.saved()) std::printf("saved %s\n", id.c_str());
+      for (const auto& e : r.failed()) std::printf("FAILED %s\n", e.c_str());
+      if (r.failed_size() > 0) throw std::runtime_error("drain: " + std::to_string(r.failed_size()) + " sessions not saved");
+    });
+  }
+  {
+    auto* cmd = app.add_subcommand("health", "grpc.health.v1 check of a server; exit code 1 unless SERVING");
+    auto f = std::make_shared<ServiceFlags>();
+    auto name = std::make_shared<std::string>();
+    auto timeout = std::make_shared<double>(5);
+    f->add(*cmd, false);
+    cmd->add_option("--service", *name, "service name: \"\" (the server), rrg.v1.SessionService (admission), liveness");
+    cmd->add_option("--timeout", *timeout, "seconds")->capture_default_str();
+    cmd->callback([=] {
+      const auto st = service::check_health(service::make_channel({f->server, f->tls_ca}), *name,
+                                            std::chrono::milliseconds(int64_t(*timeout * 1000.0)));
+      std::printf("%s\n", service::to_string(st));
+      if (st != service::HealthStatus::serving) throw std::runtime_error("health: " + std::string(service::to_string(st)));
     });
   }
   {
@@ -61,7 +98,7 @@ void register_session_commands(CLI::App& app) {
 #else
 namespace rrg::cli {
 void register_session_commands(CLI::App& app) {
-  for (const char* name : {"sessions", "save", "load"})
+  for (const char* name : {"sessions", "save", "load", "drain", "health"})
     app.add_subcommand(name, "service client (not in this build)")->callback([] {
       throw std::runtime_error("this build has no gRPC (install libgrpc++-dev protobuf-compiler-grpc, rebuild)");
     });

@@ -33,6 +33,7 @@ namespace {
 struct StreamCmdOptions {
   ServiceFlags service;
   std::string dataset, out, color = "png", depth = "rvl+zstd", semantics = "auto", name = "rrg stream";
+  std::string session_id;  // proposed id (routable through a proxy hashing x-rrg-session); "" = random
   io::DatasetFlags flags;
   std::vector<std::string> set;
   size_t max_frames = 0;
@@ -104,10 +105,17 @@ void run_stream(const StreamCmdOptions& o) {
   service::ServiceClient client = o.service.client();
   std::vector<SessionRun> runs(size_t(std::max(1, o.sessions)));
   for (size_t k = 0; k < runs.size(); ++k) {
+    // The id is chosen here so the Create already carries it in x-rrg-session (docs/deploy.md).
+    if (o.session_id.empty()) create.set_session_id(service::new_session_id());
+    else create.set_session_id(runs.size() == 1 ? o.session_id : o.session_id + "-" + std::to_string(k));
+    std::string server;
+    client.set_server_observer([&](const std::string&, const std::string&, const std::string& name) { server = name; });
     const auto r = client.create(create);
     runs[k].handle = {r.session_id(), r.token()};
-    spdlog::info("stream: session {} on {} ({})", r.session_id(), o.service.server, r.info().device());
+    spdlog::info("stream: session {} on server {} via {} ({})", r.session_id(), server.empty() ? "?" : server,
+                 o.service.server, r.info().device());
   }
+  client.set_server_observer(nullptr);
   std::mutex print_mutex;
   const auto stream_one = [&](size_t k) {
     SessionRun& run = runs[k];
@@ -176,8 +184,8 @@ void run_stream(const StreamCmdOptions& o) {
     all_rtt.insert(all_rtt.end(), s.round_trip_ms.begin(), s.round_trip_ms.end());
     total_frames += double(s.round_trip_ms.size());
     max_wall = std::max(max_wall, s.wall_s);
-    std::printf("session %s: %zu frames sent, %zu processed, %zu dropped, %zu rejected; %.2f frames/s; round trip "
-                "p50 %.1f ms, p99 %.1f ms (window %d)\n", run.handle.id.c_str(), s.sent, s.round_trip_ms.size(),
+    std::printf("session %s: server %s: %zu frames sent, %zu processed, %zu dropped, %zu rejected; %.2f frames/s; round trip "
+                "p50 %.1f ms, p99 %.1f ms (window %d)\n", run.handle.id.c_str(), s.server.empty() ? "?" : s.server.c_str(), s.sent, s.round_trip_ms.size(),
                 s.dropped, s.rejected, double(s.round_trip_ms.size()) / s.wall_s, percentile(s.round_trip_ms, 0.5),
                 percentile(s.round_trip_ms, 0.99), o.window);
     if (!gt.empty() && run.trajectory.size() >= 3) {
@@ -223,6 +231,8 @@ void register_stream_command(CLI::App& app) {
   cmd->add_option("--window", o->window, "frames in flight per session (1 = lock-step)")->capture_default_str();
   cmd->add_option("--queue", o->queue, "server-side frame queue capacity (0 = server default)");
   cmd->add_option("--name", o->name, "session name");
+  cmd->add_option("--session-id", o->session_id,
+                  "propose the session id, [a-z0-9-]{4,64} (with --sessions N: ID-0 ... ID-N-1; default: random)");
   cmd->add_option("--progress", o->progress, "log every N-th frame (0 = never)")->capture_default_str();
   cmd->add_flag("--realtime", o->realtime, "send at the dataset's frame rate (default: as fast as possible)");
   cmd->add_flag("--preload", o->preload, "encode every frame before streaming (benchmarks)");

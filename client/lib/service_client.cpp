@@ -5,6 +5,7 @@
 #include <iterator>
 #include <map>
 #include <mutex>
+#include <random>
 #include <thread>
 
 namespace rrg::service {
@@ -42,6 +43,14 @@ std::unique_ptr<grpc::ClientContext> bearer_context(const std::string& token) {
 }
 }  // namespace
 
+std::string new_session_id() {
+  std::random_device rd;
+  std::uniform_int_distribution<int> digit(0, 15);
+  std::string id = "s";
+  for (int i = 0; i < 16; ++i) id += "0123456789abcdef"[digit(rd)];
+  return id;
+}
+
 RpcError::RpcError(const std::string& call, const grpc::Status& s)
     : std::runtime_error(call + ": " + code_name(s.error_code()) + ": " + s.error_message()), code_(s.error_code()) {}
 
@@ -72,10 +81,28 @@ std::unique_ptr<grpc::ClientContext> ServiceClient::context(const SessionHandle&
   return ctx;
 }
 
+std::string ServiceClient::server_of(const grpc::ClientContext& ctx) {
+  for (const auto* md : {&ctx.GetServerInitialMetadata(), &ctx.GetServerTrailingMetadata()}) {
+    const auto it = md->find("x-rrg-server");
+    if (it != md->end()) return std::string(it->second.data(), it->second.size());
+  }
+  return {};
+}
+
+std::string ServiceClient::observe(const std::string& call, const std::string& session,
+                                   const grpc::ClientContext& ctx) const {
+  std::string server = server_of(ctx);
+  if (observer_) observer_(call, session, server);
+  return server;
+}
+
 v1::CreateSessionResponse ServiceClient::create(const v1::CreateSessionRequest& request) {
   grpc::ClientContext ctx;
+  if (!request.session_id().empty()) ctx.AddMetadata("x-rrg-session", request.session_id());
   v1::CreateSessionResponse out;
-  check("Create", stub_->Create(&ctx, request, &out));
+  const grpc::Status st = stub_->Create(&ctx, request, &out);
+  observe("Create", st.ok() ? out.session_id() : request.session_id(), ctx);
+  check("Create", st);
   return out;
 }
 
@@ -84,14 +111,27 @@ v1::SessionInfo ServiceClient::get(const SessionHandle& s) {
   v1::GetSessionRequest r;
   r.set_session_id(s.id);
   v1::SessionInfo out;
-  check("Get", stub_->Get(ctx.get(), r, &out));
+  const grpc::Status st = stub_->Get(ctx.get(), r, &out);
+  observe("Get", s.id, *ctx);
+  check("Get", st);
   return out;
 }
 
 v1::ListSessionsResponse ServiceClient::list(const std::string& admin_key) {
   auto ctx = bearer_context(admin_key);
   v1::ListSessionsResponse out;
-  check("List", stub_->List(ctx.get(), {}, &out));
+  const grpc::Status st = stub_->List(ctx.get(), {}, &out);
+  observe("List", "", *ctx);
+  check("List", st);
+  return out;
+}
+
+v1::DrainResponse ServiceClient::drain(const std::string& admin_key) {
+  auto ctx = bearer_context(admin_key);
+  v1::DrainResponse out;
+  const grpc::Status st = stub_->Drain(ctx.get(), {}, &out);
+  observe("Drain", "", *ctx);
+  check("Drain", st);
   return out;
 }
 
@@ -101,7 +141,9 @@ v1::CloseSessionResponse ServiceClient::close(const SessionHandle& s, bool save)
   r.set_session_id(s.id);
   r.set_save(save);
   v1::CloseSessionResponse out;
-  check("Close", stub_->Close(ctx.get(), r, &out));
+  const grpc::Status st = stub_->Close(ctx.get(), r, &out);
+  observe("Close", s.id, *ctx);
+  check("Close", st);
   return out;
 }
 
@@ -110,16 +152,21 @@ v1::SaveSessionResponse ServiceClient::save(const SessionHandle& s) {
   v1::SaveSessionRequest r;
   r.set_session_id(s.id);
   v1::SaveSessionResponse out;
-  check("Save", stub_->Save(ctx.get(), r, &out));
+  const grpc::Status st = stub_->Save(ctx.get(), r, &out);
+  observe("Save", s.id, *ctx);
+  check("Save", st);
   return out;
 }
 
 v1::CreateSessionResponse ServiceClient::load(const std::string& id, const std::string& token) {
   auto ctx = bearer_context(token);
+  ctx->AddMetadata("x-rrg-session", id);
   v1::LoadSessionRequest r;
   r.set_session_id(id);
   v1::CreateSessionResponse out;
-  check("Load", stub_->Load(ctx.get(), r, &out));
+  const grpc::Status st = stub_->Load(ctx.get(), r, &out);
+  observe("Load", id, *ctx);
+  check("Load", st);
   return out;
 }
 
@@ -127,11 +174,13 @@ v1::RenderViewResponse ServiceClient::render(const SessionHandle& s, v1::RenderV
   auto ctx = context(s);
   if (request.session_id().empty()) request.set_session_id(s.id);
   v1::RenderViewResponse out;
-  check("RenderView", stub_->RenderView(ctx.get(), request, &out));
+  const grpc::Status st = stub_->RenderView(ctx.get(), request, &out);
+  observe("RenderView", s.id, *ctx);
+  check("RenderView", st);
   return out;
 }
 
-Blob ServiceClient::fetch(const std::string& call, grpc::ClientContext&,
+Blob ServiceClient::fetch(const std::string& call, const std::string& session, grpc::ClientContext& ctx,
                           std::unique_ptr<grpc::ClientReader<v1::DataChunk>> reader) {
   Blob b;
   v1::DataChunk c;
@@ -144,7 +193,9 @@ Blob ServiceClient::fetch(const std::string& call, grpc::ClientContext&,
     b.count = c.count();
     b.triangles = c.triangles();
   }
-  check(call, reader->Finish());
+  const grpc::Status st = reader->Finish();
+  b.server = observe(call, session, ctx);
+  check(call, st);
   return b;
 }
 
@@ -153,7 +204,7 @@ Blob ServiceClient::mesh(const SessionHandle& s, uint64_t since_version) {
   v1::GetMeshRequest r;
   r.set_session_id(s.id);
   r.set_since_version(since_version);
-  return fetch("GetMesh", *ctx, stub_->GetMesh(ctx.get(), r));
+  return fetch("GetMesh", s.id, *ctx, stub_->GetMesh(ctx.get(), r));
 }
 
 Blob ServiceClient::gaussians(const SessionHandle& s, v1::GetGaussiansRequest::Format format,
@@ -163,7 +214,7 @@ Blob ServiceClient::gaussians(const SessionHandle& s, v1::GetGaussiansRequest::F
   r.set_session_id(s.id);
   r.set_format(format);
   r.set_set(set);
-  return fetch("GetGaussians", *ctx, stub_->GetGaussians(ctx.get(), r));
+  return fetch("GetGaussians", s.id, *ctx, stub_->GetGaussians(ctx.get(), r));
 }
 
 StreamSummary ServiceClient::stream(const SessionHandle& s, const std::function<std::optional<v1::Frame>()>& next,
@@ -225,6 +276,7 @@ StreamSummary ServiceClient::stream(const SessionHandle& s, const std::function<
   rw->WritesDone();
   reader.join();
   sum.status = rw->Finish();
+  sum.server = observe("StreamFrames", s.id, *ctx);
   sum.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
   return sum;
 }
@@ -243,7 +295,9 @@ grpc::Status ServiceClient::watch(const SessionHandle& s, const std::function<bo
       break;
     }
   }
-  return reader->Finish();
+  const grpc::Status st = reader->Finish();
+  observe("WatchSession", s.id, *ctx);
+  return st;
 }
 
 }  // namespace rrg::service

@@ -126,6 +126,15 @@ class Session {
   // Thread-safe queries.
   SessionView render(const Intrinsics& K, const Eigen::Isometry3f& T_wc) const;
   TriangleMesh mesh(uint64_t changed_since = 0) const;   // marching cubes (of blocks changed since)
+  // Chunked mesh streaming (the HTTP viewer): the resident TSDF blocks fused into after volume
+  // version `since` (0 = all) with the volume version they are current to, read under one lock;
+  // and marching cubes of just the given resident blocks (welded among themselves).
+  struct ChangedBlocks {
+    std::vector<Eigen::Vector3i> blocks;
+    uint64_t volume_version = 0;
+  };
+  ChangedBlocks changed_blocks(uint64_t since) const;
+  TriangleMesh mesh_of_blocks(const std::vector<Eigen::Vector3i>& blocks) const;
   GaussianHost base_gaussians() const;
   GaussianHost reflection_gaussians() const;
   std::vector<ReflectivePlane> reflective_planes() const;  // accepted planes with equations

@@ -35,6 +35,19 @@ TriangleMesh Session::mesh(uint64_t changed_since) const {
   return extract_mesh(s.volume, blocks, remap);
 }
 
+Session::ChangedBlocks Session::changed_blocks(uint64_t since) const {
+  const Impl& s = *impl_;
+  std::lock_guard lock(s.volume_mutex);
+  return {s.volume.changed_blocks(since), s.volume.version()};
+}
+
+TriangleMesh Session::mesh_of_blocks(const std::vector<Eigen::Vector3i>& blocks) const {
+  const Impl& s = *impl_;
+  const std::vector<int32_t> remap = s.remap_copy();
+  std::lock_guard lock(s.volume_mutex);
+  return extract_mesh(s.volume, blocks, remap);
+}
+
 GaussianHost Session::base_gaussians() const { return impl_->mapper.base_host(); }
 GaussianHost Session::reflection_gaussians() const { return impl_->mapper.reflection_host(); }
 

@@ -99,6 +99,10 @@ int ServerProcess::terminate() {
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
+void ServerProcess::signal(int sig) {
+  if (pid_ > 0) ::kill(pid_, sig);
+}
+
 std::string ServerProcess::log() const {
   std::ifstream f(log_);
   std::stringstream ss;

@@ -26,6 +26,7 @@ class ServerProcess {
   service::ServiceClient client() const { return service::ServiceClient(service::ChannelOptions{address()}); }
   void kill9();            // crash it
   int terminate();         // SIGTERM, wait; returns the exit status
+  void signal(int sig);    // sends a signal, does not wait (SIGUSR1: drain)
   std::string log() const; // its stderr so far
 
  private:
