@@ -20,6 +20,7 @@ PACKAGES=(
   libssl-dev                 # the service's tokens (RAND_bytes, SHA-256)
   nginx                      # tests/deploy: the session-affine gRPC proxy in front of 3 servers
   chromium                   # the browser viewer's end-to-end test (tests/web, headless)
+  curl                       # quickstart.sh prints the server's Prometheus metrics
 )
 
 missing=()

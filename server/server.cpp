@@ -73,6 +73,10 @@ int run_server(const ServerOptions& o) {
   std::unique_ptr<MetricsHttpServer> http;
   if (o.metrics_port >= 0)
     http = std::make_unique<MetricsHttpServer>(o.metrics_port, [&] { return metrics.prometheus_text(manager.gauges()); });
+  if (http && !o.metrics_port_file.empty())
+    io::write_atomically(o.metrics_port_file, [&](const std::filesystem::path& tmp) {
+      std::ofstream(tmp) << http->port() << "\n";
+    });
   std::unique_ptr<HttpApiServer> http_api;
   if (o.http_port >= 0) http_api = std::make_unique<HttpApiServer>(HttpApiOptions{o.http_port, o.http_port_file, o.viewer_dir}, manager);
 

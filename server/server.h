@@ -19,6 +19,7 @@ struct ServerOptions {
   std::filesystem::path tls_cert, tls_key;
   int max_message_bytes = 64 << 20;
   int metrics_port = -1;                  // -1 = no metrics endpoint, 0 = any free port
+  std::filesystem::path metrics_port_file;  // written (atomically) with the bound metrics port
   double shutdown_grace_s = 5.0;          // in-flight calls get this long before being cancelled
   int http_port = -1;                     // browser viewer + HTTP API (http_api.h): -1 = off, 0 = any
   std::filesystem::path http_port_file;   // written (atomically) with the bound HTTP port

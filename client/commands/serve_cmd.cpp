@@ -40,6 +40,7 @@ void register_serve_command(CLI::App& app) {
   cmd->add_option("--tls-key", o->tls_key, "PEM private key for --tls-cert");
   cmd->add_option("--max-message-mb", *max_message_mb, "largest message accepted or sent, MiB")->capture_default_str();
   cmd->add_option("--metrics-port", o->metrics_port, "Prometheus text endpoint port (-1 = off, 0 = any)")->capture_default_str();
+  cmd->add_option("--metrics-port-file", o->metrics_port_file, "write the bound metrics port to this file once serving");
   cmd->add_option("--shutdown-grace", o->shutdown_grace_s, "seconds in-flight calls get at shutdown")->capture_default_str();
   cmd->add_option("--http-port", o->http_port, "browser viewer + HTTP API port (-1 = off, 0 = any; docs/viewer.md)")->capture_default_str();
   cmd->add_option("--http-port-file", o->http_port_file, "write the bound HTTP port to this file once serving");
