@@ -126,4 +126,19 @@ AdamStateHost GaussianAdam::to_host() const {
   return h;
 }
 
+void GaussianAdam::from_host(const AdamStateHost& h) {
+  if (h.stride != stride_)
+    throw std::invalid_argument("GaussianAdam::from_host: state stride " + std::to_string(h.stride) + ", expected " +
+                                std::to_string(stride_) + " (SH degree differs)");
+  const size_t n = h.steps.size(), s = size_t(stride_);
+  if (h.m.size() != n * s || h.v.size() != n * s)
+    throw std::invalid_argument("GaussianAdam::from_host: moments of " + std::to_string(h.m.size()) + " / " +
+                                std::to_string(h.v.size()) + " floats for " + std::to_string(n) +
+                                " Gaussians of stride " + std::to_string(stride_));
+  reset(n);
+  mem::copy(m_.data(), device_, h.m.data(), Device::cpu(), n * s * sizeof(float));
+  mem::copy(v_.data(), device_, h.v.data(), Device::cpu(), n * s * sizeof(float));
+  mem::copy(steps_.data(), device_, h.steps.data(), Device::cpu(), n * sizeof(int32_t));
+}
+
 }  // namespace rrg

@@ -66,6 +66,10 @@ class GaussianAdam {
   int64_t step(GaussianSet& set, const GaussianGrads& grads);
 
   AdamStateHost to_host() const;
+  // Replaces the state with a host copy (session snapshots: a restored mapper continues with the
+  // moments and step counts it had). Throws std::invalid_argument when the stride or the array
+  // lengths disagree.
+  void from_host(const AdamStateHost& state);
 
  private:
   AdamParams params_;

@@ -186,6 +186,8 @@ GaussianHost densify_reflection(const DensifyView& v, std::span<const Reflective
   const Eigen::Vector3f o = v.T_wc.translation();
   const Eigen::Matrix3f R_wc = v.T_wc.linear();
   const int S = p.reflection_samples;
+  const bool mirrored = p.reflection_mirrored_depth && v.virtual_depth != nullptr;
+  if (mirrored) check_image(v.virtual_depth, v.K, "virtual_depth");
   for (int y = 0; y < v.K.height; ++y)
     for (int x = 0; x < v.K.width; ++x) {
       const int32_t id = (*v.I)(x, y);
@@ -205,6 +207,20 @@ GaussianHost densify_reflection(const DensifyView& v, std::span<const Reflective
       const Eigen::Vector3f hit = o + t * dir;
       const Color c = p.reflection_residual_color ? Color(((*v.C_gt)(x, y) - (*v.C_b)(x, y)).cwiseMax(0.0f))
                                                   : Color((*v.C_gt)(x, y));
+      if (mirrored) {
+        // One Gaussian at the mirrored surface when it lies behind the plane (the camera's
+        // side of the plane has the opposite sign).
+        const float z = (*v.virtual_depth)(x, y);
+        const Eigen::Vector3f X = v.T_wc * v.K.unproject(float(x), float(y), z);
+        const float side_cam = n.dot(o) + it->second.w(), side_X = n.dot(X) + it->second.w();
+        if (z > 0 && side_cam * side_X < 0) {
+          pts.push_back(X);
+          nrm.push_back(n);
+          col.push_back(c);
+          ids.push_back(id);
+          continue;
+        }
+      }
       for (int j = 0; j < S; ++j) {
         const float s = S == 1 ? p.reflection_near
                                : p.reflection_near + (p.reflection_far - p.reflection_near) * float(j) / float(S - 1);

@@ -53,6 +53,9 @@ struct DensifyParams {
   float init_opacity = 0.5f;
   bool reflection_residual_color = false;  // reflection colour max(C_gt − C_b, 0) instead of C_gt
   bool base_leaves_reflections = false;    // see densify_base (off: on mirror_room it cost 0.4 dB)
+  // Reflection positions: false = the paper's samples along the ray 2–8 m past the plane; true =
+  // one Gaussian at the mirrored surface (DensifyView::virtual_depth) where it is known.
+  bool reflection_mirrored_depth = false;
   void validate() const;             // throws std::invalid_argument naming the bad field
 };
 
@@ -69,6 +72,7 @@ struct DensifyView {
   const MaskImage* R = nullptr;         // reflection mask
   const Image<float>* C_var = nullptr;  // TSDF colour variance
   const Image<int32_t>* I = nullptr;    // plane ids
+  const Image<float>* virtual_depth = nullptr;  // optional: depth of the mirrored surface (mirror_depth.h)
 };
 
 // With `reflective` planes given (and params.base_leaves_reflections), the pixels that the

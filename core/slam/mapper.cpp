@@ -1,4 +1,5 @@
 #include "core/slam/mapper.h"
+#include "core/slam/mirror_depth.h"
 
 #include <spdlog/spdlog.h>
 
@@ -78,26 +79,35 @@ int64_t prune_set(GaussianSet& set, GaussianAdam& adam, const PruneParams& p) {
 
 }  // namespace
 
-// Compact host copy of a frame: 8-bit colour, depth in 1/5000 m.
-struct GaussianMapper::StoredFrame {
-  int64_t index = 0;
-  Eigen::Isometry3f T_wc = Eigen::Isometry3f::Identity();
-  int width = 0, height = 0;
-  std::vector<uint8_t> rgb;      // [H, W, 3]
-  std::vector<uint16_t> depth;   // [H, W]
+CompactFrame CompactFrame::from(const MappingFrame& frame) {
+  CompactFrame s;
+  s.index = frame.index;
+  s.T_wc = frame.T_wc;
+  s.width = frame.color.width();
+  s.height = frame.color.height();
+  s.rgb.resize(frame.color.size() * 3);
+  s.depth.resize(frame.depth.size());
+  for (size_t i = 0; i < frame.color.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      s.rgb[3 * i + c] = uint8_t(std::lround(std::clamp(frame.color[i][c], 0.0f, 1.0f) * 255.0f));
+  for (size_t i = 0; i < frame.depth.size(); ++i) {
+    const float d = frame.depth[i];
+    s.depth[i] = (d > 0 && std::isfinite(d)) ? uint16_t(std::min(std::lround(d * kDepthUnits), 65535l)) : 0;
+  }
+  return s;
+}
 
-  ColorImage color() const {
-    ColorImage c(width, height);
-    for (size_t i = 0; i < c.size(); ++i)
-      c[i] = Color(rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]) / 255.0f;
-    return c;
-  }
-  DepthImage depth_m() const {
-    DepthImage d(width, height);
-    for (size_t i = 0; i < d.size(); ++i) d[i] = float(depth[i]) / kDepthUnits;
-    return d;
-  }
-};
+ColorImage CompactFrame::color() const {
+  ColorImage c(width, height);
+  for (size_t i = 0; i < c.size(); ++i) c[i] = Color(rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]) / 255.0f;
+  return c;
+}
+
+DepthImage CompactFrame::depth_m() const {
+  DepthImage d(width, height);
+  for (size_t i = 0; i < d.size(); ++i) d[i] = float(depth[i]) / kDepthUnits;
+  return d;
+}
 
 // A selected frame for one step: ground truth on the host and the device, pass 1 at its pose.
 struct GaussianMapper::StepFrame {
@@ -133,20 +143,7 @@ void GaussianMapper::add_frame(MappingFrame frame, bool keyframe) {
                                 std::to_string(frame.color.width()) + "x" + std::to_string(frame.color.height()) +
                                 " (depth " + std::to_string(frame.depth.width()) + "x" +
                                 std::to_string(frame.depth.height()) + "), the mapper expects " + K_.to_string());
-  auto s = std::make_shared<StoredFrame>();
-  s->index = frame.index;
-  s->T_wc = frame.T_wc;
-  s->width = K_.width;
-  s->height = K_.height;
-  s->rgb.resize(frame.color.size() * 3);
-  s->depth.resize(frame.depth.size());
-  for (size_t i = 0; i < frame.color.size(); ++i)
-    for (int c = 0; c < 3; ++c)
-      s->rgb[3 * i + c] = uint8_t(std::lround(std::clamp(frame.color[i][c], 0.0f, 1.0f) * 255.0f));
-  for (size_t i = 0; i < frame.depth.size(); ++i) {
-    const float d = frame.depth[i];
-    s->depth[i] = (d > 0 && std::isfinite(d)) ? uint16_t(std::min(std::lround(d * kDepthUnits), 65535l)) : 0;
-  }
+  auto s = std::make_shared<StoredFrame>(CompactFrame::from(frame));
   std::lock_guard lock(frames_mutex_);
   recent_.push_back(s);
   if (keyframe) keyframes_.push_back(s);
@@ -256,6 +253,11 @@ MappingStats GaussianMapper::step(const MappingContext& ctx) {
     v.R = &f.R;
     v.C_var = &f.C_var;
     v.I = &I;
+    Image<float> virtual_depth;
+    if (reflections && params_.densify.reflection_mirrored_depth) {
+      virtual_depth = mirrored_depth(ctx.raycast, K_, f.frame->T_wc, I, ctx.planes);
+      v.virtual_depth = &virtual_depth;
+    }
     const uint64_t fseed = mix(seed ^ mix(uint64_t(f.frame->index)));
     const GaussianHost nb = densify_base(v, params_.densify, params_.sh_degree, fseed,
                                          reflections ? std::span<const ReflectivePlane>(ctx.planes) : std::span<const ReflectivePlane>{});
@@ -342,6 +344,64 @@ void GaussianMapper::load(const GaussianHost& base, const GaussianHost& reflecti
   adam_base_.reset(base_.size());
   adam_refl_.reset(refl_.size());
   publish();
+}
+
+MapperState GaussianMapper::export_state() const {
+  std::lock_guard step_lock(step_mutex_);
+  MapperState st;
+  st.steps = steps_;
+  st.adam_base = adam_base_.to_host();
+  st.adam_reflection = adam_refl_.to_host();
+  std::lock_guard lock(frames_mutex_);
+  std::vector<const StoredFrame*> seen;  // a frame is both recent and a keyframe until the next step
+  const auto index_of = [&](const std::shared_ptr<const StoredFrame>& f) {
+    const auto it = std::find(seen.begin(), seen.end(), f.get());
+    if (it != seen.end()) return uint32_t(it - seen.begin());
+    seen.push_back(f.get());
+    st.frames.push_back(*f);
+    return uint32_t(seen.size() - 1);
+  };
+  for (const auto& f : keyframes_) st.keyframes.push_back(index_of(f));
+  for (const auto& f : recent_) st.recent.push_back(index_of(f));
+  return st;
+}
+
+void GaussianMapper::import_state(MapperState st) {
+  std::lock_guard step_lock(step_mutex_);
+  if (st.adam_base.steps.size() != base_.size() || st.adam_reflection.steps.size() != refl_.size())
+    throw std::invalid_argument("GaussianMapper::import_state: Adam state for " + std::to_string(st.adam_base.steps.size()) +
+                                " + " + std::to_string(st.adam_reflection.steps.size()) + " Gaussians, the map has " +
+                                std::to_string(base_.size()) + " + " + std::to_string(refl_.size()));
+  std::vector<std::shared_ptr<const StoredFrame>> frames;
+  for (CompactFrame& f : st.frames) {
+    if (f.width != K_.width || f.height != K_.height || f.rgb.size() != size_t(f.width) * f.height * 3 ||
+        f.depth.size() != size_t(f.width) * f.height)
+      throw std::invalid_argument("GaussianMapper::import_state: frame " + std::to_string(f.index) + " is " +
+                                  std::to_string(f.width) + "x" + std::to_string(f.height) + ", the mapper expects " +
+                                  K_.to_string());
+    frames.push_back(std::make_shared<const StoredFrame>(std::move(f)));
+  }
+  const auto pick = [&](const std::vector<uint32_t>& ids, auto& out) {
+    for (const uint32_t i : ids) {
+      if (i >= frames.size())
+        throw std::invalid_argument("GaussianMapper::import_state: frame reference " + std::to_string(i) + " of " +
+                                    std::to_string(frames.size()));
+      out.push_back(frames[i]);
+    }
+  };
+  std::vector<std::shared_ptr<const StoredFrame>> keyframes;
+  std::deque<std::shared_ptr<const StoredFrame>> recent;
+  pick(st.keyframes, keyframes);
+  pick(st.recent, recent);
+  GaussianAdam adam_base(params_.adam_base, base_.sh_degree(), device_), adam_refl(params_.adam_reflection, refl_.sh_degree(), device_);
+  adam_base.from_host(st.adam_base);
+  adam_refl.from_host(st.adam_reflection);
+  adam_base_ = std::move(adam_base);
+  adam_refl_ = std::move(adam_refl);
+  steps_ = st.steps;
+  std::lock_guard lock(frames_mutex_);
+  keyframes_ = std::move(keyframes);
+  recent_ = std::move(recent);
 }
 
 }  // namespace rrg

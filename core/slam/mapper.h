@@ -70,6 +70,32 @@ struct MappingFrame {            // one posed RGB-D frame (host)
   DepthImage depth;              // D_gt, metres, 0 = invalid
 };
 
+// Compact host copy of a mapping frame as the mapper keeps it: 8-bit colour, depth in 1/5000 m.
+// from() quantises; color() / depth_m() expand, and from() of the expansion gives the same bytes
+// (snapshots store frames in this form, bit for bit).
+struct CompactFrame {
+  int64_t index = 0;
+  Eigen::Isometry3f T_wc = Eigen::Isometry3f::Identity();
+  int width = 0, height = 0;
+  std::vector<uint8_t> rgb;      // [H, W, 3]
+  std::vector<uint16_t> depth;   // [H, W], 1/5000 m, 0 = invalid
+  static CompactFrame from(const MappingFrame& frame);
+  ColorImage color() const;
+  DepthImage depth_m() const;
+  MappingFrame expand() const { return {index, T_wc, color(), depth_m()}; }
+};
+
+// What a step depends on besides the two Gaussian sets (session snapshots): the step counter
+// (it seeds the frame selection), the stored frames with the keyframe list (N_global sampling)
+// and the frames since the last step (N_local), and both sets' Adam state.
+struct MapperState {
+  uint64_t steps = 0;
+  std::vector<CompactFrame> frames;   // each stored frame once
+  std::vector<uint32_t> keyframes;    // indices into frames, in insertion order
+  std::vector<uint32_t> recent;       // indices into frames, oldest first
+  AdamStateHost adam_base, adam_reflection;
+};
+
 struct MappingContext {
   // Pass 1 at a camera (the session serialises it against fusion).
   std::function<RaycastResult(const Intrinsics&, const Eigen::Isometry3f&)> raycast;
@@ -109,6 +135,11 @@ class GaussianMapper {
   GaussianHost reflection_host() const;
   // Replaces both sets (session load); optimiser state restarts. Publishes a snapshot.
   void load(const GaussianHost& base, const GaussianHost& reflection);
+  // The state of a step boundary (waits for a running step), and its restoration after load():
+  // throws std::invalid_argument when the Adam state does not match the loaded sets or a frame
+  // does not match K (the mapper is unchanged then).
+  MapperState export_state() const;
+  void import_state(MapperState state);
 
   const MapperParams& params() const { return params_; }
   const Intrinsics& intrinsics() const { return K_; }
@@ -116,7 +147,7 @@ class GaussianMapper {
   size_t keyframes() const;
 
  private:
-  struct StoredFrame;            // compact host copy (mapper.cpp)
+  using StoredFrame = CompactFrame;
   struct StepFrame;              // a selected frame with its images on the device for one step
   std::vector<std::shared_ptr<const StoredFrame>> select_frames(uint64_t seed);
   void publish();
@@ -135,7 +166,7 @@ class GaussianMapper {
   std::deque<std::shared_ptr<const StoredFrame>> recent_;
   std::vector<std::shared_ptr<const StoredFrame>> keyframes_;
 
-  std::mutex step_mutex_;
+  mutable std::mutex step_mutex_;
   mutable std::mutex snapshot_mutex_;
   std::shared_ptr<const MapSnapshot> snapshot_;
   uint64_t version_ = 0;

@@ -41,8 +41,14 @@ void add_mapper_config_fields(ConfigTable& t, MapperParams& p) {
   t.f("densify.reflection_near", p.densify.reflection_near, "first sample past the plane, metres");
   t.f("densify.reflection_far", p.densify.reflection_far, "last sample past the plane, metres");
   t.f("densify.max_init_scale", p.densify.max_init_scale, "cap of the initial scale, metres");
+  t.f("densify.reflection_max_init_scale", p.densify.reflection_max_init_scale,
+      "cap of a reflection Gaussian's initial scale, metres");
+  t.f("densify.reflection_min_init_scale", p.densify.reflection_min_init_scale,
+      "floor of a reflection Gaussian's initial scale, metres");
   t.b("densify.base_leaves_reflections", p.densify.base_leaves_reflections,
       "no base Gaussians where the reflection set may densify (R = 1, C_var > δ_v on a reflective plane)");
+  t.b("densify.reflection_mirrored_depth", p.densify.reflection_mirrored_depth,
+      "reflection Gaussians at the mirrored TSDF surface instead of samples 2-8 m past the plane");
   t.b("densify.reflection_residual_color", p.densify.reflection_residual_color,
       "reflection colour from max(C_gt − C_b, 0) instead of C_gt");
   t.f("prune.base.min_opacity", p.prune_base.min_opacity, "base: prune below this opacity");

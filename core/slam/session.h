@@ -143,7 +143,8 @@ class Session {
   SessionStatus status() const;
 
   // Snapshots: versioned, checksummed, written atomically (a failed save leaves the old file).
-  // load() rebuilds a session that continues where the saved one stopped.
+  // load() rebuilds a session that continues where the saved one stopped: exactly as the saved
+  // session would have (format v2: keyframes, motion and optimiser state are saved; docs/slam.md).
   void save(const std::filesystem::path& file) const;
   static std::unique_ptr<Session> load(const std::filesystem::path& file,
                                        std::unique_ptr<SemanticCue> cue = nullptr);

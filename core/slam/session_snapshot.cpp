@@ -1,15 +1,20 @@
 // Session snapshots (docs/slam.md "Snapshots"): one file, written atomically:
-//   magic "RRGSESS\0", format version u32, payload size u64, FNV-1a 64 of the payload, payload:
+//   magic "RRGSESS\0", format version u32, payload size u64, FNV-1a 64 of the payload, payload.
+// Payload v2 = the continuation section (its length, then core/slam/snapshot_continuation.h: the
+// tracker's ORB keyframes and motion state, the mapper's step counter, stored keyframes, frames
+// since the last step and both Adam states, the session's fused frames not yet handed to the
+// mapper), followed by the v1 payload:
 //   config (YAML text + category table), schedule counters and the last pose, trajectory and
 //   per-frame reports, the TSDF (its own versioned file format, embedded), base and reflection
 //   Gaussians, the plane identifier's state, the accepted reflective planes and the id remap.
-// Not saved: the mapper's keyframe images and Adam moments, and the tracker's ORB keyframes;
-// after a load, mapping continues with the frames that follow and tracking resumes from the
-// last pose against the restored TSDF.
+// A v2 snapshot continues exactly as the uninterrupted session (sync mode, tested bit for bit on
+// the CPU). v1 files still load: the map is the same, but the tracker resumes from the last pose
+// with no keyframes and zero velocity, and the mapper from no keyframes and fresh Adam moments.
 #include "core/io/atomic_file.h"
 #include "core/io/byte_stream.h"
 #include "core/planes/plane_state_io.h"
 #include "core/slam/session_impl.h"
+#include "core/slam/snapshot_continuation.h"
 #include "core/tsdf/tsdf_io.h"
 
 #include <spdlog/spdlog.h>
@@ -26,7 +31,7 @@ namespace rrg {
 namespace {
 
 constexpr char kMagic[8] = {'R', 'R', 'G', 'S', 'E', 'S', 'S', '\0'};
-constexpr uint32_t kVersion = 1;
+constexpr uint32_t kVersion = 2;  // 1: no continuation section (still read)
 
 void put_floats(io::ByteWriter& w, const float* p, size_t n) {
   w.put<uint64_t>(n);
@@ -133,6 +138,20 @@ void Session::save(const std::filesystem::path& file) const {
   // with the worker idle; the volume lock keeps renders out while the TSDF is copied).
   s.worker.wait();
   io::ByteWriter w;
+  size_t continuation_bytes = 0, stored_frames = 0;
+  {
+    ContinuationState c;
+    c.tracker = s.tracker.export_state();
+    c.mapper = s.mapper.export_state();
+    for (size_t i = 0; i < s.pending.size(); ++i) {
+      c.pending.push_back(CompactFrame::from(s.pending[i]));
+      c.pending_keyframe.push_back(s.pending_keyframe[i] ? 1 : 0);
+    }
+    const std::vector<uint8_t> section = write_continuation(c);
+    continuation_bytes = section.size();
+    stored_frames = c.mapper.frames.size() + c.pending.size();
+    w.put_bytes(section);
+  }
   SessionConfig config = s.config;
   w.put_string(config_to_yaml(config));
   w.put<uint64_t>(config.categories.size());
@@ -177,7 +196,8 @@ void Session::save(const std::filesystem::path& file) const {
     f.flush();
     if (!f) throw std::runtime_error("session save: cannot write " + file.string());
   });
-  spdlog::debug("session: saved {} frames, {} bytes -> {}", s.frames, payload.size(), file.string());
+  spdlog::debug("session: saved {} frames, {} bytes ({} in the continuation section: {} stored frames, Adam state) -> {}",
+                s.frames, payload.size(), continuation_bytes, stored_frames, file.string());
 }
 
 std::unique_ptr<Session> Session::load(const std::filesystem::path& file, std::unique_ptr<SemanticCue> cue) {
@@ -191,12 +211,14 @@ std::unique_ptr<Session> Session::load(const std::filesystem::path& file, std::u
   std::memcpy(&version, bytes.data() + 8, 4);
   std::memcpy(&size, bytes.data() + 12, 8);
   std::memcpy(&sum, bytes.data() + 20, 8);
-  if (version != kVersion) throw std::runtime_error(what + ": unsupported version " + std::to_string(version));
+  if (version != 1 && version != kVersion)
+    throw std::runtime_error(what + ": unsupported version " + std::to_string(version));
   if (size != bytes.size() - kHeader) throw std::runtime_error(what + ": truncated (payload size mismatch)");
   const std::span<const uint8_t> payload(bytes.data() + kHeader, size);
   if (fnv1a64(payload) != sum) throw std::runtime_error(what + ": checksum mismatch (corrupt file)");
 
   io::ByteReader r(payload, what);
+  const std::span<const uint8_t> continuation = version >= 2 ? r.get_bytes() : std::span<const uint8_t>{};
   SessionConfig config;
   {
     const std::string yaml = r.get_string();
@@ -252,7 +274,26 @@ std::unique_ptr<Session> Session::load(const std::filesystem::path& file, std::u
   PlaneStateIo::read(r, s.identifier);
   s.global_planes = s.identifier.table().live_ids().size();
   if (r.remaining() != 0) throw std::runtime_error(what + ": " + std::to_string(r.remaining()) + " unexpected trailing bytes");
-  if (s.frames > 0) s.tracker.resume(s.T_last);
+  if (version >= 2) {
+    ContinuationState c = read_continuation(continuation, what);
+    s.tracker.import_state(c.tracker);
+    try {
+      s.mapper.import_state(std::move(c.mapper));
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error(what + ": " + e.what());
+    }
+    for (size_t i = 0; i < c.pending.size(); ++i) {
+      if (c.pending[i].width != s.K.width || c.pending[i].height != s.K.height)
+        throw std::runtime_error(what + ": pending frame " + std::to_string(c.pending[i].index) + " has the wrong size");
+      s.pending.push_back(c.pending[i].expand());
+      s.pending_keyframe.push_back(c.pending_keyframe[i] != 0);
+    }
+    s.tracker_keyframes = s.tracker.keyframes().size();
+  } else {
+    spdlog::info("{}: format v1 has no keyframes, motion or optimiser state; tracking resumes from the last pose "
+                 "and mapping from the frames that follow", what);
+    if (s.frames > 0) s.tracker.resume(s.T_last);
+  }
   return session;
 }
 

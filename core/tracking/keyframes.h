@@ -38,6 +38,8 @@ class KeyframeSet {
   const Keyframe& back() const { return frames_.back(); }
   // The `count` most recent keyframes, newest first.
   std::vector<const Keyframe*> recent(int count) const;
+  const std::deque<Keyframe>& all() const { return frames_; }  // oldest first
+  void clear() { frames_.clear(); }
 
  private:
   int max_;

@@ -50,6 +50,29 @@ void Tracker::resume(const Eigen::Isometry3f& T_wc) {
   velocity_ = Eigen::Isometry3f::Identity();
 }
 
+TrackerState Tracker::export_state() const {
+  TrackerState s;
+  s.started = started_;
+  s.T_initial = T_initial_;
+  s.T_prev = T_prev_;
+  s.velocity = velocity_;
+  s.state = state_;
+  s.next_keyframe_id = next_keyframe_id_;
+  s.keyframes.assign(keyframes_.all().begin(), keyframes_.all().end());
+  return s;
+}
+
+void Tracker::import_state(const TrackerState& s) {
+  started_ = s.started;
+  T_initial_ = s.T_initial;
+  T_prev_ = s.T_prev;
+  velocity_ = s.velocity;
+  state_ = s.state;
+  next_keyframe_id_ = s.next_keyframe_id;
+  keyframes_.clear();
+  for (const Keyframe& k : s.keyframes) keyframes_.add(k);
+}
+
 bool Tracker::icp_failed(const IcpResult& icp) const {
   return icp.diverged || icp.valid == 0 || icp.inlier_ratio < params_.icp.min_inlier_ratio;
 }

@@ -47,6 +47,18 @@ struct TrackResult {
   double ms_preprocess = 0, ms_icp = 0, ms_orb = 0;
 };
 
+// Everything track() carries from one frame to the next (session snapshots: a restored tracker
+// continues exactly as the uninterrupted one; serialised by core/tracking/tracker_state_io.h).
+struct TrackerState {
+  bool started = false;
+  Eigen::Isometry3f T_initial = Eigen::Isometry3f::Identity();
+  Eigen::Isometry3f T_prev = Eigen::Isometry3f::Identity();    // T_{k−1}
+  Eigen::Isometry3f velocity = Eigen::Isometry3f::Identity();  // T_{k−2}⁻¹ T_{k−1}
+  TrackingState state = TrackingState::Ok;
+  int next_keyframe_id = 0;
+  std::vector<Keyframe> keyframes;  // oldest first
+};
+
 class Tracker {
  public:
   // Throws std::invalid_argument for bad params or intrinsics.
@@ -60,6 +72,10 @@ class Tracker {
   // Continues a stream that stopped at T_wc (a restored session snapshot): the next frame is tracked
   // against the model, predicted at T_wc with zero velocity; no keyframes are kept.
   void resume(const Eigen::Isometry3f& T_wc);
+  // The carried state, and its restoration (keyframes beyond params.keyframes.max_keyframes drop
+  // the oldest, as add() does). The last frame's pyramid is not part of it: track() rebuilds it.
+  TrackerState export_state() const;
+  void import_state(const TrackerState& state);
 
   // Tracks one frame. `model` serves the map raycast (not used on the first frame); `masks` gives
   // R_k^track in icp+orb+mask mode (required there). Throws std::invalid_argument on size mismatch.

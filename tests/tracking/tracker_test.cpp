@@ -4,6 +4,7 @@
 #include "core/io/trajectory.h"
 #include "core/tracking/se3.h"
 #include "core/tracking/tracker.h"
+#include "core/tracking/tracker_state_io.h"
 #include "core/tsdf/tsdf_integrate.h"
 #include "tests/support/test_support.h"
 
@@ -124,6 +125,38 @@ TEST_F(SynthSequence, OrbRefinementMatchesKeyframePoints) {
   }
   EXPECT_GT(matches, 0);
   EXPECT_GT(refined, 0);
+}
+
+// Session snapshots: the state written and read back (ORB keyframes, motion, ids) makes a fresh
+// tracker take the next frame exactly as the original; a truncated record is refused.
+TEST_F(SynthSequence, ExportedStateContinuesExactlyThroughItsBinaryForm) {
+  TrackingParams p;
+  p.mode = TrackingMode::IcpOrb;
+  Rig rig(root(), p);
+  for (size_t i = 0; i < 8; ++i) ASSERT_NE(rig.step(i).state, TrackingState::Lost) << "frame " << i;
+  io::ByteWriter w;
+  write_tracker_state(w, rig.tracker.export_state());
+  io::ByteReader r(w.bytes(), "tracker state");
+  Tracker copy(p, rig.dataset->intrinsics(), Device::cpu());
+  copy.import_state(read_tracker_state(r));
+  EXPECT_EQ(r.remaining(), 0u);
+  ASSERT_EQ(copy.keyframes().size(), rig.tracker.keyframes().size());
+  const Keyframe& ka = rig.tracker.keyframes().back();
+  const Keyframe& kb = copy.keyframes().back();
+  EXPECT_EQ(ka.id, kb.id);
+  ASSERT_EQ(ka.keypoints.size(), kb.keypoints.size());
+  EXPECT_EQ(cv::norm(ka.descriptors, kb.descriptors, cv::NORM_HAMMING), 0.0);
+  EXPECT_TRUE(ka.points_world == kb.points_world);
+  EXPECT_TRUE(copy.predicted_pose().isApprox(rig.tracker.predicted_pose(), 0.0));
+  const io::Frame f = rig.dataset->load(8);
+  const TrackResult a = rig.tracker.track({8, &f.color, &f.depth, nullptr}, rig.model, &rig.masks);
+  const TrackResult b = copy.track({8, &f.color, &f.depth, nullptr}, rig.model, &rig.masks);
+  EXPECT_TRUE(a.T_wc.isApprox(b.T_wc, 0.0));
+  EXPECT_EQ(a.orb_matches, b.orb_matches);
+  EXPECT_EQ(a.keyframe, b.keyframe);
+  const std::vector<uint8_t>& bytes = w.bytes();
+  io::ByteReader cut(std::span<const uint8_t>(bytes.data(), bytes.size() - 1), "cut tracker state");
+  EXPECT_THROW(read_tracker_state(cut), std::runtime_error);
 }
 
 TEST_F(SynthSequence, MaskModeNeedsAMaskSource) {
