@@ -13,21 +13,40 @@ namespace rrg {
 namespace {
 
 // Pixels at least `border_m` (on the image at their depth) inside their region of `map`: every
-// pixel of the square of radius ceil(border_m · fx / z) around them carries the same non-zero value.
+// pixel of the square of radius r = ceil(border_m · fx / z) around them carries the same non-zero
+// value. O(pixels): a two-pass chessboard distance transform gives each pixel the distance k to the
+// nearest pixel of its region that touches another value (8-neighbourhood) or the image border;
+// the square of radius r is then uniform exactly when k >= r.
 template <class T>
 MaskImage interior(const Image<T>& map, const DepthImage& depth, const Intrinsics& K, float border_m) {
   const int w = map.width(), h = map.height();
+  Image<int32_t> k(w, h, 0);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      bool edge = x == 0 || y == 0 || x == w - 1 || y == h - 1;
+      for (int dy = -1; !edge && dy <= 1; ++dy)
+        for (int dx = -1; !edge && dx <= 1; ++dx) edge = map(x + dx, y + dy) != map(x, y);
+      k(x, y) = edge ? 0 : w + h;
+    }
+  for (int y = 1; y < h; ++y)  // forward: left, upper-left, up, upper-right
+    for (int x = 1; x < w; ++x) {
+      int d = std::min(k(x - 1, y), std::min(k(x - 1, y - 1), k(x, y - 1)));
+      if (x + 1 < w) d = std::min(d, k(x + 1, y - 1));
+      k(x, y) = std::min(k(x, y), d + 1);
+    }
+  for (int y = h - 2; y >= 0; --y)  // backward: right, lower-right, down, lower-left
+    for (int x = w - 2; x >= 0; --x) {
+      int d = std::min(k(x + 1, y), std::min(k(x + 1, y + 1), k(x, y + 1)));
+      if (x > 0) d = std::min(d, k(x - 1, y + 1));
+      k(x, y) = std::min(k(x, y), d + 1);
+    }
   MaskImage inner(w, h, 0);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      const T id = map(x, y);
       const float z = depth(x, y);
-      if (id == T(0) || !(z > 0)) continue;
+      if (map(x, y) == T(0) || !(z > 0)) continue;
       const int r = border_m > 0 ? std::min(16, int(std::ceil(border_m * K.fx / z))) : 0;
-      bool ok = x - r >= 0 && y - r >= 0 && x + r < w && y + r < h;
-      for (int v = y - r; ok && v <= y + r; ++v)
-        for (int u = x - r; ok && u <= x + r; ++u) ok = map(u, v) == id;
-      inner(x, y) = ok ? 1 : 0;
+      inner(x, y) = k(x, y) >= r ? 1 : 0;
     }
   return inner;
 }
