@@ -91,8 +91,18 @@ size_t SessionManager::used_bytes() const {
   return used;
 }
 
+// A Create / Load that reserved `id` (admit + reserved_ids_) is done: the session goes live, or,
+// with `managed` null (construction failed), only the reservation is released.
+void SessionManager::end_construction(const std::string& id, std::shared_ptr<ManagedSession> managed) {
+  std::lock_guard lock(mutex_);
+  reserved_ids_.erase(id);
+  if (!managed) return;
+  drained_.erase(id);
+  sessions_[id] = std::move(managed);
+}
+
 void SessionManager::admit(size_t extra) const {
-  const size_t n = sessions_.size() + pending_;
+  const size_t n = sessions_.size() + reserved_ids_.size();
   if (n + extra > options_.max_sessions)
     throw exhausted("admission: the server already runs " + std::to_string(n) + " sessions (max " +
                     std::to_string(options_.max_sessions) + ")");
@@ -100,7 +110,7 @@ void SessionManager::admit(size_t extra) const {
     // Every session may grow to its per-session budget, so that much is reserved per session.
     const size_t used = used_bytes();
     const size_t reserve = options_.session_memory_budget;
-    const size_t reserved = std::max(used, (sessions_.size() + pending_) * reserve);
+    const size_t reserved = std::max(used, (sessions_.size() + reserved_ids_.size()) * reserve);
     if (reserved + reserve > options_.total_memory_budget || used >= options_.total_memory_budget)
       throw exhausted("admission: memory budget: " + std::to_string(reserved) + " bytes in use or reserved, a new "
                       "session reserves " + std::to_string(reserve) + ", total budget " +
@@ -150,7 +160,6 @@ v1::CreateSessionResponse SessionManager::create(const grpc::ServerContextBase& 
       throw StatusError(grpc::StatusCode::ALREADY_EXISTS, "session_id: " + id +
                                                               " is taken (saved in the snapshot folder: Load it, or choose another id)");
     admit(1);
-    ++pending_;
     reserved_ids_.insert(id);
   }
   std::shared_ptr<ManagedSession> managed;
@@ -173,18 +182,10 @@ v1::CreateSessionResponse SessionManager::create(const grpc::ServerContextBase& 
     out.set_session_id(managed->meta().id);
     out.set_token(token);
   } catch (...) {
-    std::lock_guard lock(mutex_);
-    --pending_;
-    reserved_ids_.erase(id);
+    end_construction(id, nullptr);
     throw;
   }
-  {
-    std::lock_guard lock(mutex_);
-    --pending_;
-    reserved_ids_.erase(id);
-    drained_.erase(id);
-    sessions_[managed->meta().id] = managed;
-  }
+  end_construction(id, managed);
   metrics_.session_created();
   *out.mutable_info() = managed->info();
   spdlog::info("session {} created: '{}', {}x{}, device {}, queue {}", out.session_id(), r.name(),
@@ -312,7 +313,6 @@ v1::CreateSessionResponse SessionManager::load(const grpc::ServerContextBase& ct
     if (sessions_.count(id) || reserved_ids_.count(id))
       throw StatusError(grpc::StatusCode::ALREADY_EXISTS, "load: session " + id + " is live on server " + options_.server_name);
     admit(1);
-    ++pending_;
     reserved_ids_.insert(id);
   }
   v1::CreateSessionResponse out;
@@ -334,18 +334,10 @@ v1::CreateSessionResponse SessionManager::load(const grpc::ServerContextBase& ct
     out.set_session_id(id);
     out.set_token(new_tok);
   } catch (...) {
-    std::lock_guard lock(mutex_);
-    --pending_;
-    reserved_ids_.erase(id);
+    end_construction(id, nullptr);
     throw;
   }
-  {
-    std::lock_guard lock(mutex_);
-    --pending_;
-    reserved_ids_.erase(id);
-    drained_.erase(id);
-    sessions_[id] = managed;
-  }
+  end_construction(id, managed);
   metrics_.session_created();
   *out.mutable_info() = managed->info();
   spdlog::info("session {} loaded: {} frames, map version {}", id, out.info().frames(), out.info().map_version());
@@ -388,7 +380,7 @@ v1::DrainResponse SessionManager::drain() {
   for (int i = 0; i < 600; ++i) {
     {
       std::lock_guard lock(mutex_);
-      if (pending_ == 0) break;
+      if (reserved_ids_.empty()) break;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }

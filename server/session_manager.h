@@ -80,14 +80,14 @@ class SessionManager {
   std::filesystem::path meta_file(const std::string& id) const;
   void write_meta(const ManagedSession& s) const;
   void reap_idle();
+  void end_construction(const std::string& id, std::shared_ptr<ManagedSession> managed);
 
   ManagerOptions options_;
   Metrics& metrics_;
   mutable std::mutex mutex_;
   std::map<std::string, std::shared_ptr<ManagedSession>> sessions_;
   std::map<std::string, bool> drained_;  // id -> snapshot written
-  std::set<std::string> reserved_ids_;   // ids of sessions being constructed (Create / Load)
-  size_t pending_ = 0;  // admitted, being constructed
+  std::set<std::string> reserved_ids_;   // ids of sessions admitted and being constructed (Create / Load)
   std::atomic<bool> draining_{false};
   std::mutex drain_mutex_;  // one drain at a time
 
