@@ -29,6 +29,7 @@
 namespace {
 
 namespace o3c = open3d::core;
+constexpr int64_t kBlockCapacity = 40000;
 namespace o3g = open3d::t::geometry;
 
 // Wall-clock and process CPU time (all threads: on a shared machine the CPU time is the steadier
@@ -108,11 +109,12 @@ int main(int argc, char** argv) {
   params.voxel_size = voxel;
   params.truncation = truncation;
   params.max_depth = max_depth;
+  params.initial_blocks = kBlockCapacity;  // both start with the same preallocated block pool
   rrg::TsdfVolume ours(params, cpu);
   const float trunc_mult = truncation / voxel;
   const o3c::Device o3d_cpu("CPU:0");
   o3g::VoxelBlockGrid vbg({"tsdf", "weight", "color"}, {o3c::Float32, o3c::Float32, o3c::Float32},
-                          {{1}, {1}, {3}}, voxel, 8, 40000, o3d_cpu);
+                          {{1}, {1}, {3}}, voxel, 8, kBlockCapacity, o3d_cpu);
   const o3c::Tensor intr = intrinsic_tensor(K);
 
   std::vector<rrg::DeviceImage<float>> depth;

@@ -38,12 +38,15 @@ int64_t integrate_any(TsdfVolume& volume, const DeviceImage<float>& depth, const
   const VertexNormalMaps maps = compute_vertex_normal_maps(depth, K);
   const Eigen::Matrix3f R_wc = T_wc.linear();
   const Eigen::Vector3f t_wc = T_wc.translation();
-  const Span<const int32_t> active = volume.allocate_from_depth(depth, K, R_wc, t_wc);
   const TsdfParams& p = volume.params();
+  DeviceImage<kernel::FusionPixel> pixels(K.width, K.height, dev);
+  const kernel::FusionPixelArgs pa{depth.view(), maps.normals.view(), K, p.min_depth, p.max_depth, pixels.view()};
+  RRG_DISPATCH(dev, kernel::fusion_pixels_cpu(pa), kernel::fusion_pixels_cuda(pa));
+  const Span<const int32_t> active = volume.allocate_from_depth(depth, K, R_wc, t_wc);
   const Eigen::Matrix3f R_cw = R_wc.transpose();
-  kernel::IntegrateArgs<ColorT> a{depth.view(), color.view(), maps.normals.view(), K, R_cw, Eigen::Vector3f(-(R_cw * t_wc)),
-                                  p.voxel_size, p.truncation, p.min_depth, p.max_depth, p.max_weight,
-                                  p.reflection_window, active, volume.block_keys(), volume.voxels(),
+  kernel::IntegrateArgs<ColorT> a{pixels.view(), color.view(), K, R_cw, Eigen::Vector3f(-(R_cw * t_wc)),
+                                  p.voxel_size, p.truncation, p.max_weight, p.reflection_window, active,
+                                  volume.block_keys(), volume.geometry(), volume.attributes(),
                                   volume.block_versions(), volume.version(), refl != nullptr,
                                   refl ? refl->plane_ids->view() : ImageView<const int32_t>{},
                                   refl ? refl->reflection_mask->view() : ImageView<const uint8_t>{},

@@ -3,6 +3,7 @@
 
 namespace rrg::kernel {
 
+void fusion_pixels_cpu(const FusionPixelArgs& a) { fusion_pixels(CpuBackend{}, a); }
 void integrate_cpu(const IntegrateArgs<Eigen::Vector3f>& a) { integrate(CpuBackend{}, a); }
 void integrate_cpu(const IntegrateArgs<Rgb8>& a) { integrate(CpuBackend{}, a); }
 

@@ -3,6 +3,7 @@
 
 namespace rrg::kernel {
 
+void fusion_pixels_cuda(const FusionPixelArgs& a) { fusion_pixels(CudaBackend{}, a); }
 void integrate_cuda(const IntegrateArgs<Eigen::Vector3f>& a) {
   integrate(CudaBackend{}, a);
   RRG_CUDA_CHECK(cudaStreamSynchronize(nullptr));

@@ -23,12 +23,13 @@ RRG_HD inline int32_t canonical_plane(Span<const int32_t> remap, int32_t id) {
 
 // Standard fusion with one observation of normalised distance t_obs = min(1, sdf / ε):
 //   d ← (W d + t_obs) / (W + 1),  c̄_{n+1} = (n c̄_n + c_t) / (n + 1) with n = W,  W ← min(W + 1, W_max)
-RRG_HD inline void fuse_sdf_color(Voxel& v, float t_obs, const Eigen::Vector3f& c, int max_weight) {
-  const float w = float(v.weight), inv = 1.0f / (w + 1.0f);
-  v.tsdf = voxel_codec::encode_tsdf((voxel_codec::decode_tsdf(v.tsdf) * w + t_obs) * inv);
+RRG_HD inline void fuse_sdf_color(TsdfVoxel& g, AttrVoxel& a, float t_obs, const Eigen::Vector3f& c,
+                                  int max_weight) {
+  const float w = float(g.weight), inv = 1.0f / (w + 1.0f);
+  g.tsdf = voxel_codec::encode_tsdf((voxel_codec::decode_tsdf(g.tsdf) * w + t_obs) * inv);
   for (int k = 0; k < 3; ++k)
-    v.rgb[k] = voxel_codec::encode_unit((voxel_codec::decode_unit(v.rgb[k]) * w + c[k]) * inv);
-  v.weight = uint16_t(v.weight + 1 > max_weight ? max_weight : v.weight + 1);
+    a.rgb[k] = voxel_codec::encode_unit((voxel_codec::decode_unit(a.rgb[k]) * w + c[k]) * inv);
+  g.weight = uint16_t(g.weight + 1 > max_weight ? max_weight : g.weight + 1);
 }
 
 // Reflection attributes, only on identification frames and only inside the band |sdf| < ε:
@@ -36,7 +37,7 @@ RRG_HD inline void fuse_sdf_color(Voxel& v, float t_obs, const Eigen::Vector3f& 
 //   r ← r + (m_t − r) / min(n + 1, W)   (mean of the masks so far, then an average over ~W windows)
 //   π ← canonical(id) when the pixel has a plane, else unchanged
 // n saturates at 65535 (the updates then continue with that count).
-RRG_HD inline void fuse_reflection(Voxel& v, const Eigen::Vector3f& c, float mask, int32_t plane, int window) {
+RRG_HD inline void fuse_reflection(AttrVoxel& v, const Eigen::Vector3f& c, float mask, int32_t plane, int window) {
   const uint32_t n1 = v.n < 65535 ? uint32_t(v.n) + 1 : 65535u;
   const float x = (c.x() + c.y() + c.z()) * (1.0f / 3.0f);
   const float delta = x - v.mu;

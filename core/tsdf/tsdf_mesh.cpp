@@ -67,7 +67,7 @@ TriangleMesh mesh_pool_blocks(const TsdfVolume& volume, const std::vector<int32_
     const size_t m = std::min(blocks.size() - start, size_t(kBatchBlocks));
     const auto blocks_d = Buffer<int32_t>::from_host(std::span(blocks).subspan(start, m), dev);
     Buffer<int32_t> scratch(m * kernel::kEdgeSlots, dev), counts(2 * m, dev);
-    kernel::MeshArgs a{{volume.hash_view(), volume.voxels(), volume.params().voxel_size},
+    kernel::MeshArgs a{{volume.hash_view(), volume.geometry(), volume.attributes(), volume.params().voxel_size},
                        volume.block_keys(), blocks_d.span(), table.span(), remap.span(), scratch.span(),
                        false, counts.span(), {}, {}, {}, {}, {}, {}};
     RRG_DISPATCH(dev, kernel::mesh_blocks_cpu(a), kernel::mesh_blocks_cuda(a));

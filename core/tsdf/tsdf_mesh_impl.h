@@ -38,11 +38,12 @@ void mesh_blocks(Backend backend, const MeshArgs& a) {
       const Eigen::Vector3i c = bc + Eigen::Vector3i(o & 1, (o >> 1) & 1, o >> 2);
       nb[o] = block_in_range(c.x(), c.y(), c.z()) ? hash_find(args.volume.hash, block_key(c.x(), c.y(), c.z())) : -1;
     }
-    const auto fetch = [&](const Eigen::Vector3i& l) -> const Voxel* {
+    // Pool index of the voxel at local coordinates l (0..8), or -1 when missing or unobserved.
+    const auto fetch = [&](const Eigen::Vector3i& l) -> int64_t {
       const int o = (l.x() >> 3) | ((l.y() >> 3) << 1) | ((l.z() >> 3) << 2);
-      if (nb[o] < 0) return nullptr;
-      const Voxel* v = &args.volume.voxels[int64_t(nb[o]) * kBlockVoxels + local_index(l.x() & 7, l.y() & 7, l.z() & 7)];
-      return v->weight > 0 ? v : nullptr;
+      if (nb[o] < 0) return -1;
+      const int64_t v = int64_t(nb[o]) * kBlockVoxels + local_index(l.x() & 7, l.y() & 7, l.z() & 7);
+      return args.volume.geometry[v].weight > 0 ? v : -1;
     };
     int32_t* slots = &args.scratch[j * kEdgeSlots];
     for (int k = 0; k < kEdgeSlots; ++k) slots[k] = -1;
@@ -55,9 +56,9 @@ void mesh_blocks(Backend backend, const MeshArgs& a) {
           int m = 0;
           bool ok = true;
           for (int c = 0; c < 8 && ok; ++c) {
-            const Voxel* v = fetch(Eigen::Vector3i(x + (c & 1), y + ((c >> 1) & 1), z + (c >> 2)));
-            if (!v) ok = false;
-            else if (v->tsdf < 0) m |= 1 << c;
+            const int64_t v = fetch(Eigen::Vector3i(x + (c & 1), y + ((c >> 1) & 1), z + (c >> 2)));
+            if (v < 0) ok = false;
+            else if (args.volume.geometry[v].tsdf < 0) m |= 1 << c;
           }
           if (!ok || m == 0 || m == 255) continue;
           const int8_t* tri = &args.table[int64_t(m) * mc::kStride];
@@ -72,9 +73,11 @@ void mesh_blocks(Backend backend, const MeshArgs& a) {
                 if (args.emit) {
                   Eigen::Vector3i lb = la;
                   lb[axis] += 1;
-                  const Voxel& va = *fetch(la);
-                  const Voxel& vb = *fetch(lb);
-                  const float fa = voxel_codec::decode_tsdf(va.tsdf), fb = voxel_codec::decode_tsdf(vb.tsdf);
+                  const int64_t ia = fetch(la), ib = fetch(lb);
+                  const AttrVoxel& va = args.volume.attributes[ia];
+                  const AttrVoxel& vb = args.volume.attributes[ib];
+                  const float fa = voxel_codec::decode_tsdf(args.volume.geometry[ia].tsdf);
+                  const float fb = voxel_codec::decode_tsdf(args.volume.geometry[ib].tsdf);
                   const float u = fa / (fa - fb);
                   const Eigen::Vector3i g = bc * int(kBlockSide) + la;
                   Eigen::Vector3f p = g.cast<float>();
@@ -82,7 +85,7 @@ void mesh_blocks(Backend backend, const MeshArgs& a) {
                   const int64_t out = v0 + slots[slot];
                   args.positions[out] = p * s;
                   args.colors[out] = voxel_color(va) + u * (voxel_color(vb) - voxel_color(va));
-                  const Voxel& near = (fabsf(fa) <= fabsf(fb) && va.plane) || !vb.plane ? va : vb;
+                  const AttrVoxel& near = (fabsf(fa) <= fabsf(fb) && va.plane) || !vb.plane ? va : vb;
                   args.planes[out] = canonical_plane(args.remap, int32_t(near.plane));
                   args.edge_keys[out] = Eigen::Vector4i(g.x(), g.y(), g.z(), axis);
                 }

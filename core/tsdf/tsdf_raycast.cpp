@@ -21,7 +21,7 @@ RaycastResult raycast(const TsdfVolume& volume, const Intrinsics& K, const Eigen
   const int tiles_x = (w + kernel::kRangeTile - 1) / kernel::kRangeTile;
   const int tiles_y = (h + kernel::kRangeTile - 1) / kernel::kRangeTile;
   Buffer<int32_t> near(size_t(tiles_x) * size_t(tiles_y), dev), far(size_t(tiles_x) * size_t(tiles_y), dev);
-  kernel::RaycastArgs a{{volume.hash_view(), volume.voxels(), p.voxel_size},
+  kernel::RaycastArgs a{{volume.hash_view(), volume.geometry(), volume.attributes(), p.voxel_size},
                         volume.block_keys(), K, T_wc.linear(), T_wc.translation(), p.truncation,
                         p.min_depth, p.max_depth, {near.span(), far.span(), tiles_x, tiles_y},
                         remap.span(), r.depth.view(), r.vertices.view(), r.normals.view(), r.colors.view(),

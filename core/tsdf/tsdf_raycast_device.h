@@ -48,7 +48,7 @@ RRG_HD inline RayHit march(const VolumeView& vol, const Eigen::Vector3f& o, cons
   while (z < z_end) {
     const Eigen::Vector3f p = o + z * d;
     const Eigen::Vector3i g(int(floorf(p.x() / s)), int(floorf(p.y() / s)), int(floorf(p.z() / s)));
-    if (!voxel_at(vol, g, cache)) {  // empty space: skip the whole block
+    if (voxel_at(vol, g, cache) < 0) {  // empty space: skip the whole block
       z += block_exit(p, d, s) + 1e-3f * s / len;
       have_prev = false;
       continue;
@@ -113,10 +113,11 @@ RRG_HD inline SurfaceSample shade(const VolumeView& vol, const Eigen::Vector3f& 
   if (!trilinear_corners(vol, p, cache, c)) return out;
   float w_refl = 0.0f;
   for (int i = 0; i < 8; ++i) {
-    out.color += c.w[i] * voxel_color(*c.v[i]);
-    if (c.v[i]->n > 0) {
-      out.variance += c.w[i] * voxel_variance(*c.v[i]);
-      out.reflection += c.w[i] * voxel_codec::decode_unit(c.v[i]->r);
+    const AttrVoxel& a = vol.attributes[c.v[i]];
+    out.color += c.w[i] * voxel_color(a);
+    if (a.n > 0) {
+      out.variance += c.w[i] * voxel_variance(a);
+      out.reflection += c.w[i] * voxel_codec::decode_unit(a.r);
       w_refl += c.w[i];
     }
   }
@@ -124,7 +125,8 @@ RRG_HD inline SurfaceSample shade(const VolumeView& vol, const Eigen::Vector3f& 
   out.reflection /= (w_refl + kEps);
   const float s = vol.voxel_size;
   const Eigen::Vector3i g(int(floorf(p.x() / s + 0.5f)), int(floorf(p.y() / s + 0.5f)), int(floorf(p.z() / s + 0.5f)));
-  if (const Voxel* v = voxel_at(vol, g, cache)) out.plane = canonical_plane(remap, int32_t(v->plane));
+  if (const int64_t v = voxel_at(vol, g, cache); v >= 0)
+    out.plane = canonical_plane(remap, int32_t(vol.attributes[v].plane));
   // Normal: central differences of the trilinear TSDF one voxel apart; within the cell otherwise.
   Eigen::Vector3f grad;
   bool ok = true;
@@ -139,7 +141,7 @@ RRG_HD inline SurfaceSample shade(const VolumeView& vol, const Eigen::Vector3f& 
     const Eigen::Vector3f q = p / s;
     const Eigen::Vector3f f(q.x() - floorf(q.x()), q.y() - floorf(q.y()), q.z() - floorf(q.z()));
     float t[8];
-    for (int i = 0; i < 8; ++i) t[i] = voxel_codec::decode_tsdf(c.v[i]->tsdf);
+    for (int i = 0; i < 8; ++i) t[i] = voxel_codec::decode_tsdf(vol.geometry[c.v[i]].tsdf);
     const auto lerp = [](float a, float b, float u) { return a + (b - a) * u; };
     grad.x() = lerp(lerp(t[1] - t[0], t[3] - t[2], f.y()), lerp(t[5] - t[4], t[7] - t[6], f.y()), f.z());
     grad.y() = lerp(lerp(t[2] - t[0], t[3] - t[1], f.x()), lerp(t[6] - t[4], t[7] - t[5], f.x()), f.z());

@@ -9,8 +9,11 @@ void clear_hash_cpu(HashView h) { clear_hash(CpuBackend{}, h); }
 void insert_known_cpu(HashView h, Span<const uint64_t> keys, int32_t first, int32_t* failed) {
   insert_known(CpuBackend{}, h, keys, first, failed);
 }
-void copy_blocks_cpu(Span<const Voxel> src, Span<Voxel> dst, Span<const int32_t> index, bool scatter) {
-  copy_blocks(CpuBackend{}, src, dst, index, scatter);
+void gather_blocks_cpu(PoolView pool, Span<const int32_t> index, Span<Voxel> records) {
+  gather_blocks(CpuBackend{}, pool, index, records);
+}
+void scatter_blocks_cpu(Span<const Voxel> records, Span<const int32_t> index, PoolView pool) {
+  scatter_blocks(CpuBackend{}, records, index, pool);
 }
 
 }  // namespace rrg::kernel

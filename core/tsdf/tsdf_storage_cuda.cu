@@ -19,9 +19,11 @@ void insert_known_cuda(HashView h, Span<const uint64_t> keys, int32_t first, int
   insert_known(CudaBackend{}, h, keys, first, failed);
   RRG_CUDA_CHECK(cudaStreamSynchronize(nullptr));
 }
-void copy_blocks_cuda(Span<const Voxel> src, Span<Voxel> dst, Span<const int32_t> index, bool scatter) {
-  copy_blocks(CudaBackend{}, src, dst, index, scatter);
-  RRG_CUDA_CHECK(cudaStreamSynchronize(nullptr));
+void gather_blocks_cuda(PoolView pool, Span<const int32_t> index, Span<Voxel> records) {
+  gather_blocks(CudaBackend{}, pool, index, records);
+}
+void scatter_blocks_cuda(Span<const Voxel> records, Span<const int32_t> index, PoolView pool) {
+  scatter_blocks(CudaBackend{}, records, index, pool);
 }
 
 }  // namespace rrg::kernel

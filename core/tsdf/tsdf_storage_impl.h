@@ -58,39 +58,57 @@ RRG_HD void for_blocks_on_segment(const Eigen::Vector3f& a, const Eigen::Vector3
   }
 }
 
-// Per valid depth pixel: every block on its ray within [d - ε, d + ε] is found or inserted.
+inline constexpr int kTouchRun = 8;    // pixels of a row per work item of touch_blocks
+inline constexpr int kTouchCache = 8;  // recent block keys a work item remembers
+
+// Per valid depth pixel: every block on its ray within [d - ε, d + ε] is found or inserted. A work
+// item takes a run of kTouchRun pixels of one row: neighbouring pixels cross mostly the same blocks
+// (a 4 cm block spans ~10 pixels at 2 m), so a key met again within the run is skipped instead of
+// probing the hash table and its atomics again.
 template <class Backend>
 void touch_blocks(Backend backend, const TouchArgs& a) {
   const TouchArgs args = a;
   const int w = a.depth.width;
-  parallel_for(backend, a.depth.size(), [=] RRG_HD(int64_t i) {
-    const float d = args.depth[i];
-    if (!(d >= args.min_depth && d <= args.max_depth)) return;
-    const float x = float(i % w), y = float(i / w);
+  const int runs_per_row = (w + kTouchRun - 1) / kTouchRun;
+  parallel_for(backend, int64_t(runs_per_row) * a.depth.height, [=] RRG_HD(int64_t item) {
+    const int y = int(item / runs_per_row), x0 = int(item % runs_per_row) * kTouchRun;
+    const int x1 = x0 + kTouchRun < w ? x0 + kTouchRun : w;
+    uint64_t recent[kTouchCache];
+    for (int k = 0; k < kTouchCache; ++k) recent[k] = kEmptyKey;
+    int next = 0;
     const float to_block = 1.0f / (args.voxel_size * kBlockSide);
     const float half = 0.5f / kBlockSide;  // voxel g covers [g - 1/2, g + 1/2) voxel units
-    const float d0 = fmaxf(d - args.truncation, 1e-3f), d1 = d + args.truncation;
-    const Eigen::Vector3f p0 = args.R_wc * args.K.unproject(x, y, d0) + args.t_wc;
-    const Eigen::Vector3f p1 = args.R_wc * args.K.unproject(x, y, d1) + args.t_wc;
-    const Eigen::Vector3f q0 = p0 * to_block + Eigen::Vector3f::Constant(half);
-    const Eigen::Vector3f q1 = p1 * to_block + Eigen::Vector3f::Constant(half);
-    for_blocks_on_segment(q0, q1, [&](const Eigen::Vector3i& c) {
-      if (!block_in_range(c.x(), c.y(), c.z())) return;
-      const uint64_t key = block_key(c.x(), c.y(), c.z());
-      int64_t slot = 0;
-      const InsertResult r = hash_insert(args.hash, key, slot);
-      if (r == InsertResult::Inserted) {
-        const int32_t k = atomic_add(&args.counters[0], int32_t{1});
-        args.new_keys[k] = key;
-        args.new_slots[k] = int32_t(slot);
-      } else if (r == InsertResult::Found) {
-        const int32_t block = args.hash.values[slot];
-        if (block >= 0 && atomic_max(&args.stamps[block], args.pass_id) < args.pass_id)
-          args.active[atomic_add(&args.counters[1], int32_t{1})] = block;
-      } else {
-        atomic_add(&args.counters[2], int32_t{1});
-      }
-    });
+    for (int x = x0; x < x1; ++x) {
+      const float d = args.depth(x, y);
+      if (!(d >= args.min_depth && d <= args.max_depth)) continue;
+      const float d0 = fmaxf(d - args.truncation, 1e-3f), d1 = d + args.truncation;
+      const Eigen::Vector3f p0 = args.R_wc * args.K.unproject(float(x), float(y), d0) + args.t_wc;
+      const Eigen::Vector3f p1 = args.R_wc * args.K.unproject(float(x), float(y), d1) + args.t_wc;
+      const Eigen::Vector3f q0 = p0 * to_block + Eigen::Vector3f::Constant(half);
+      const Eigen::Vector3f q1 = p1 * to_block + Eigen::Vector3f::Constant(half);
+      for_blocks_on_segment(q0, q1, [&](const Eigen::Vector3i& c) {
+        if (!block_in_range(c.x(), c.y(), c.z())) return;
+        const uint64_t key = block_key(c.x(), c.y(), c.z());
+        for (int k = 0; k < kTouchCache; ++k)
+          if (recent[k] == key) return;
+        int64_t slot = 0;
+        const InsertResult r = hash_insert(args.hash, key, slot);
+        if (r == InsertResult::Inserted) {
+          const int32_t k = atomic_add(&args.counters[0], int32_t{1});
+          args.new_keys[k] = key;
+          args.new_slots[k] = int32_t(slot);
+        } else if (r == InsertResult::Found) {
+          const int32_t block = args.hash.values[slot];
+          if (block >= 0 && atomic_max(&args.stamps[block], args.pass_id) < args.pass_id)
+            args.active[atomic_add(&args.counters[1], int32_t{1})] = block;
+        } else {
+          atomic_add(&args.counters[2], int32_t{1});
+          return;  // not remembered: a later pixel must count the failure too
+        }
+        recent[next] = key;
+        next = (next + 1) % kTouchCache;
+      });
+    }
   });
 }
 
@@ -106,7 +124,8 @@ struct AppendArgs {
   uint64_t version;
   Span<int32_t> active;        // new blocks are listed at active[active_offset + j] (if >= 0)
   int32_t active_offset;
-  Span<Voxel> voxels;          // new blocks are zeroed
+  Span<TsdfVoxel> geometry;    // new blocks are zeroed in both layers
+  Span<AttrVoxel> attributes;
 };
 
 template <class Backend>
@@ -121,8 +140,10 @@ void append_blocks(Backend backend, const AppendArgs& a) {
     if (args.active_offset >= 0) args.active[args.active_offset + j] = block;
   });
   const int64_t first_voxel = int64_t(a.first_block) * kBlockVoxels;
-  parallel_for(backend, a.keys.size * kBlockVoxels,
-               [=] RRG_HD(int64_t i) { args.voxels[first_voxel + i] = Voxel{}; });
+  parallel_for(backend, a.keys.size * kBlockVoxels, [=] RRG_HD(int64_t i) {
+    args.geometry[first_voxel + i] = TsdfVoxel{};
+    args.attributes[first_voxel + i] = AttrVoxel{};
+  });
 }
 
 template <class Backend>
@@ -145,17 +166,28 @@ void insert_known(Backend backend, HashView h, Span<const uint64_t> keys, int32_
   });
 }
 
-// dst block j = src block index[j] (gather) or dst block index[j] = src block j (scatter).
+// The block pool's two voxel layers (voxel.h).
+struct PoolView {
+  Span<TsdfVoxel> geometry;
+  Span<AttrVoxel> attributes;
+};
+
+// records block j = pool block index[j], as whole Voxel records (gather).
 template <class Backend>
-void copy_blocks(Backend backend, Span<const Voxel> src, Span<Voxel> dst, Span<const int32_t> index,
-                 bool scatter) {
+void gather_blocks(Backend backend, PoolView pool, Span<const int32_t> index, Span<Voxel> records) {
   parallel_for(backend, index.size * kBlockVoxels, [=] RRG_HD(int64_t i) {
-    const int64_t j = i / kBlockVoxels, v = i % kBlockVoxels;
-    const int64_t b = index[j];
-    if (scatter)
-      dst[b * kBlockVoxels + v] = src[i];
-    else
-      dst[i] = src[b * kBlockVoxels + v];
+    const int64_t b = index[i / kBlockVoxels], v = i % kBlockVoxels;
+    records[i] = join_voxel(pool.geometry[b * kBlockVoxels + v], pool.attributes[b * kBlockVoxels + v]);
+  });
+}
+
+// pool block index[j] = records block j (scatter).
+template <class Backend>
+void scatter_blocks(Backend backend, Span<const Voxel> records, Span<const int32_t> index, PoolView pool) {
+  parallel_for(backend, index.size * kBlockVoxels, [=] RRG_HD(int64_t i) {
+    const int64_t b = index[i / kBlockVoxels], v = i % kBlockVoxels;
+    pool.geometry[b * kBlockVoxels + v] = voxel_geometry(records[i]);
+    pool.attributes[b * kBlockVoxels + v] = voxel_attributes(records[i]);
   });
 }
 
@@ -167,7 +199,9 @@ void clear_hash_cpu(HashView h);
 void clear_hash_cuda(HashView h);
 void insert_known_cpu(HashView h, Span<const uint64_t> keys, int32_t first, int32_t* failed);
 void insert_known_cuda(HashView h, Span<const uint64_t> keys, int32_t first, int32_t* failed);
-void copy_blocks_cpu(Span<const Voxel> src, Span<Voxel> dst, Span<const int32_t> index, bool scatter);
-void copy_blocks_cuda(Span<const Voxel> src, Span<Voxel> dst, Span<const int32_t> index, bool scatter);
+void gather_blocks_cpu(PoolView pool, Span<const int32_t> index, Span<Voxel> records);
+void gather_blocks_cuda(PoolView pool, Span<const int32_t> index, Span<Voxel> records);
+void scatter_blocks_cpu(Span<const Voxel> records, Span<const int32_t> index, PoolView pool);
+void scatter_blocks_cuda(Span<const Voxel> records, Span<const int32_t> index, PoolView pool);
 
 }  // namespace rrg::kernel

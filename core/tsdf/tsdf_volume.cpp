@@ -33,9 +33,12 @@ void resize_keep(Buffer<T>& b, int64_t capacity, int64_t keep, const Device& dev
   b = std::move(bigger);
 }
 
-// Initial hash slots per initial pool block: 4096 blocks -> 65536 slots (768 KB), enough for the
-// ~20k blocks a 640x480 frame at 5 mm touches without a grow-and-retry pass.
-constexpr int64_t kHashSlotsPerBlock = 16;
+// Initial hash slots: 4 per initial pool block, and at least 65536 (768 KB), enough for the ~20k
+// blocks a 640x480 frame at 5 mm touches without a grow-and-retry pass. Not more: every ray step
+// through empty space probes the table for an absent block, so a table far beyond the load needed
+// misses the caches for nothing (grow_hash_for keeps the load at most 1/2 as blocks come).
+constexpr int64_t kHashSlotsPerBlock = 4;
+constexpr int64_t kMinHashSlots = 65536;
 
 Eigen::Vector3f block_center(const Eigen::Vector3i& c, float voxel_size) {
   return (c.cast<float>() * float(kBlockSide) + Eigen::Vector3f::Constant(3.5f)) * voxel_size;
@@ -47,13 +50,14 @@ TsdfVolume::TsdfVolume(const TsdfParams& params, const Device& device) : params_
   params_.validate();
   require_device(device_);
   const int64_t blocks = params_.initial_blocks;
-  voxels_ = Buffer<Voxel>(size_t(blocks) * kBlockVoxels, device_);
+  geometry_ = Buffer<TsdfVoxel>(size_t(blocks) * kBlockVoxels, device_);
+  attributes_ = Buffer<AttrVoxel>(size_t(blocks) * kBlockVoxels, device_);
   block_keys_ = Buffer<uint64_t>(size_t(blocks), device_);
   block_versions_ = Buffer<uint64_t>(size_t(blocks), device_);
   block_stamps_ = Buffer<int32_t>::zeros(size_t(blocks), device_);
   active_ = Buffer<int32_t>(size_t(blocks), device_);
   counters_ = Buffer<int32_t>::zeros(4, device_);
-  rehash(next_pow2(kHashSlotsPerBlock * blocks));
+  rehash(next_pow2(std::max(kHashSlotsPerBlock * blocks, kMinHashSlots)));
 }
 
 kernel::HashView TsdfVolume::hash_view() const {
@@ -65,7 +69,7 @@ kernel::HashView TsdfVolume::hash_view() const {
 MemoryUsage TsdfVolume::memory() const {
   MemoryUsage m;
   m.device_bytes = hash_keys_.size() * sizeof(uint64_t) + hash_values_.size() * sizeof(int32_t) +
-                   voxels_.size() * sizeof(Voxel) +
+                   geometry_.size() * sizeof(TsdfVoxel) + attributes_.size() * sizeof(AttrVoxel) +
                    block_keys_.size() * (2 * sizeof(uint64_t) + sizeof(int32_t)) +
                    new_keys_.size() * sizeof(uint64_t) + new_slots_.size() * sizeof(int32_t) +
                    active_.size() * sizeof(int32_t) + counters_.size() * sizeof(int32_t);
@@ -95,8 +99,7 @@ std::optional<BlockData> TsdfVolume::read_block(const Eigen::Vector3i& coord) co
   const auto it = std::find(keys.begin(), keys.end(), key);
   if (it == keys.end()) return std::nullopt;
   const size_t i = size_t(it - keys.begin());
-  BlockData b{coord, 0, std::vector<Voxel>(kBlockVoxels)};
-  mem::copy(b.voxels.data(), Device::cpu(), voxels_.data() + i * kBlockVoxels, device_, kBlockVoxels * sizeof(Voxel));
+  BlockData b{coord, 0, gather_records({int32_t(i)}).to_host()};
   mem::copy(&b.version, Device::cpu(), block_versions_.data() + i, device_, sizeof(uint64_t));
   return b;
 }
@@ -104,7 +107,9 @@ std::optional<BlockData> TsdfVolume::read_block(const Eigen::Vector3i& coord) co
 std::vector<BlockData> TsdfVolume::read_all_blocks() const {
   const auto keys = download_prefix(block_keys_, num_blocks_);
   const auto versions = download_prefix(block_versions_, num_blocks_);
-  const auto voxels = download_prefix(voxels_, num_blocks_ * kBlockVoxels);
+  std::vector<int32_t> all(static_cast<size_t>(num_blocks_));
+  std::iota(all.begin(), all.end(), 0);
+  const auto voxels = gather_records(all).to_host();
   std::vector<BlockData> out;
   out.reserve(keys.size() + host_blocks_.size());
   for (size_t i = 0; i < keys.size(); ++i)
@@ -122,7 +127,8 @@ void TsdfVolume::ensure_pool(int64_t blocks) {
   if (blocks <= capacity) return;
   const int64_t bigger = std::max(blocks, capacity + capacity / 2);
   spdlog::debug("tsdf: block pool {} -> {} blocks", capacity, bigger);
-  resize_keep(voxels_, bigger * kBlockVoxels, num_blocks_ * kBlockVoxels, device_);
+  resize_keep(geometry_, bigger * kBlockVoxels, num_blocks_ * kBlockVoxels, device_);
+  resize_keep(attributes_, bigger * kBlockVoxels, num_blocks_ * kBlockVoxels, device_);
   resize_keep(block_keys_, bigger, num_blocks_, device_);
   resize_keep(block_versions_, bigger, num_blocks_, device_);
   resize_keep(block_stamps_, bigger, num_blocks_, device_);
@@ -209,7 +215,7 @@ void TsdfVolume::append_blocks(std::span<const uint64_t> keys, std::span<const i
   const int64_t capacity = int64_t(block_keys_.size());
   kernel::AppendArgs a{hash_view(), keys_d.span(), slots_d.span(), int32_t(first),
                        block_keys_.span(), block_versions_.span(), block_stamps_.span(), pass_id_, version_,
-                       {active_.data(), capacity}, int32_t(active_offset), voxels_.span()};
+                       {active_.data(), capacity}, int32_t(active_offset), geometry_.span(), attributes_.span()};
   RRG_DISPATCH(device_, kernel::append_blocks_cpu(a), kernel::append_blocks_cuda(a));
   num_blocks_ += n;
   // Blocks coming back from host memory: their voxels replace the zeros.
@@ -221,12 +227,7 @@ void TsdfVolume::append_blocks(std::span<const uint64_t> keys, std::span<const i
     staged.insert(staged.end(), restored[size_t(j)]->voxels.begin(), restored[size_t(j)]->voxels.end());
   }
   if (!index.empty()) {
-    const auto index_d = Buffer<int32_t>::from_host(index, device_);
-    const auto staged_d = Buffer<Voxel>::from_host(staged, device_);
-    const Span<const Voxel> src = staged_d.span();
-    const Span<const int32_t> idx = index_d.span();
-    RRG_DISPATCH(device_, kernel::copy_blocks_cpu(src, voxels_.span(), idx, true),
-                 kernel::copy_blocks_cuda(src, voxels_.span(), idx, true));
+    scatter_records(Buffer<Voxel>::from_host(staged, device_), index);
     for (int64_t j = 0; j < n; ++j)
       if (restored[size_t(j)]) host_blocks_.erase(keys[size_t(j)]);
     spdlog::debug("tsdf: {} blocks streamed back in", index.size());
@@ -255,9 +256,11 @@ void TsdfVolume::insert_blocks(std::span<const BlockData> blocks) {
   ensure_pool(first + n);
   mem::copy(block_keys_.data() + first, device_, keys.data(), Device::cpu(), keys.size() * sizeof(uint64_t));
   mem::copy(block_versions_.data() + first, device_, versions.data(), Device::cpu(), versions.size() * sizeof(uint64_t));
-  mem::copy(voxels_.data() + first * kBlockVoxels, device_, staged.data(), Device::cpu(), staged.size() * sizeof(Voxel));
   mem::fill_zero(block_stamps_.data() + first, size_t(n) * sizeof(int32_t), device_);
   num_blocks_ += n;
+  std::vector<int32_t> index(static_cast<size_t>(n));
+  std::iota(index.begin(), index.end(), int32_t(first));
+  scatter_records(Buffer<Voxel>::from_host(staged, device_), index);
   rehash(std::max(hash_capacity(), next_pow2(4 * num_blocks_)));
 }
 
@@ -269,25 +272,17 @@ int64_t TsdfVolume::stream_out(const Eigen::Vector3f& center, float radius) {
     ((block_center(block_coord(keys[size_t(i)]), params_.voxel_size) - center).norm() > radius ? out : keep)
         .push_back(int32_t(i));
   if (out.empty()) return 0;
-  const auto gather = [&](const std::vector<int32_t>& which, Buffer<Voxel>& dst) {
-    const auto index_d = Buffer<int32_t>::from_host(which, device_);
-    const Span<const Voxel> src = voxels();
-    const Span<const int32_t> idx = index_d.span();
-    RRG_DISPATCH(device_, kernel::copy_blocks_cpu(src, dst.span(), idx, false),
-                 kernel::copy_blocks_cuda(src, dst.span(), idx, false));
-  };
-  Buffer<Voxel> moved(out.size() * kBlockVoxels, device_);
-  gather(out, moved);
-  const std::vector<Voxel> host = moved.to_host();
+  const std::vector<Voxel> host = gather_records(out).to_host();
   for (size_t j = 0; j < out.size(); ++j) {
     const uint64_t key = keys[size_t(out[j])];
     host_blocks_[key] = BlockData{block_coord(key), versions[size_t(out[j])],
                                   std::vector<Voxel>(host.begin() + j * kBlockVoxels, host.begin() + (j + 1) * kBlockVoxels)};
   }
-  // Compact the pool to the kept blocks and rebuild the hash.
-  Buffer<Voxel> kept(voxels_.size(), device_);
-  gather(keep, kept);
-  voxels_ = std::move(kept);
+  // Compact the pool to the kept blocks (in their order) and rebuild the hash.
+  const Buffer<Voxel> kept = gather_records(keep);
+  std::vector<int32_t> front(keep.size());
+  std::iota(front.begin(), front.end(), 0);
+  scatter_records(kept, front);
   std::vector<uint64_t> kept_keys, kept_versions;
   for (int32_t i : keep) {
     kept_keys.push_back(keys[size_t(i)]);
@@ -314,6 +309,27 @@ int64_t TsdfVolume::stream_in(const Eigen::Vector3f& center, float radius) {
   insert_blocks(back);
   for (const BlockData& b : back) host_blocks_.erase(block_key(b.coord.x(), b.coord.y(), b.coord.z()));
   return int64_t(back.size());
+}
+
+kernel::PoolView TsdfVolume::pool() { return {geometry_.span(), attributes_.span()}; }
+
+Buffer<Voxel> TsdfVolume::gather_records(const std::vector<int32_t>& index) const {
+  if (index.empty()) return Buffer<Voxel>(0, device_);
+  const auto index_d = Buffer<int32_t>::from_host(index, device_);
+  Buffer<Voxel> records(index.size() * kBlockVoxels, device_);
+  const kernel::PoolView p = const_cast<TsdfVolume&>(*this).pool();  // read only
+  const Span<const int32_t> idx = index_d.span();
+  RRG_DISPATCH(device_, kernel::gather_blocks_cpu(p, idx, records.span()),
+               kernel::gather_blocks_cuda(p, idx, records.span()));
+  return records;
+}
+
+void TsdfVolume::scatter_records(const Buffer<Voxel>& records, const std::vector<int32_t>& index) {
+  if (index.empty()) return;
+  const auto index_d = Buffer<int32_t>::from_host(index, device_);
+  const Span<const Voxel> src = records.span();
+  const Span<const int32_t> idx = index_d.span();
+  RRG_DISPATCH(device_, kernel::scatter_blocks_cpu(src, idx, pool()), kernel::scatter_blocks_cuda(src, idx, pool()));
 }
 
 int64_t TsdfVolume::stream_in_all() {

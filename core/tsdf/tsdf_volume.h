@@ -14,6 +14,7 @@
 #include "core/common/camera.h"
 #include "core/tsdf/tsdf_params.h"
 #include "core/tsdf/voxel.h"
+#include "core/tsdf/tsdf_storage_impl.h"
 #include "core/tsdf/voxel_hash_device.h"
 
 #include <Eigen/Core>
@@ -73,8 +74,11 @@ class TsdfVolume {
   // --- used by the algorithms (tsdf_integrate.cpp, tsdf_raycast.cpp, ...) -----------------------
   kernel::HashView hash_view() { return {hash_keys_.span(), hash_values_.span()}; }
   kernel::HashView hash_view() const;
-  Span<Voxel> voxels() { return {voxels_.data(), num_blocks_ * kBlockVoxels}; }
-  Span<const Voxel> voxels() const { return {voxels_.data(), num_blocks_ * kBlockVoxels}; }
+  // The two voxel layers of the resident blocks (voxel.h), [num_blocks * 512] each.
+  Span<TsdfVoxel> geometry() { return {geometry_.data(), num_blocks_ * kBlockVoxels}; }
+  Span<const TsdfVoxel> geometry() const { return {geometry_.data(), num_blocks_ * kBlockVoxels}; }
+  Span<AttrVoxel> attributes() { return {attributes_.data(), num_blocks_ * kBlockVoxels}; }
+  Span<const AttrVoxel> attributes() const { return {attributes_.data(), num_blocks_ * kBlockVoxels}; }
   Span<const uint64_t> block_keys() const { return {block_keys_.data(), num_blocks_}; }
   Span<uint64_t> block_versions() { return {block_versions_.data(), num_blocks_}; }
   // Allocates (and brings back from the host) every block on the rays of the valid depth pixels
@@ -92,12 +96,17 @@ class TsdfVolume {
   void grow_hash_for(int64_t blocks);     // keeps the load factor <= 1/2
   void append_blocks(std::span<const uint64_t> keys, std::span<const int64_t> slots,
                      std::span<const BlockData* const> restored, int64_t active_offset);
+  kernel::PoolView pool();
+  // Voxel records (on the volume's device) of the resident blocks `index`, and the way back.
+  Buffer<Voxel> gather_records(const std::vector<int32_t>& index) const;
+  void scatter_records(const Buffer<Voxel>& records, const std::vector<int32_t>& index);
 
   TsdfParams params_;
   Device device_;
   Buffer<uint64_t> hash_keys_;       // [capacity] packed block coordinates, kEmptyKey = free
   Buffer<int32_t> hash_values_;      // [capacity] block index, -1 = free
-  Buffer<Voxel> voxels_;             // [pool capacity * 512]
+  Buffer<TsdfVoxel> geometry_;       // [pool capacity * 512] geometry layer
+  Buffer<AttrVoxel> attributes_;     // [pool capacity * 512] attribute layer
   Buffer<uint64_t> block_keys_;      // [pool capacity]
   Buffer<uint64_t> block_versions_;  // [pool capacity] version of the last fusion into the block
   Buffer<int32_t> block_stamps_;     // [pool capacity] allocation pass that last listed it active

@@ -1,9 +1,15 @@
 #pragma once
 // One voxel of the augmented TSDF (paper §3.1, supplement "TSDF Color Variance Update") and the
 // packing of block coordinates into hash keys. Plain structs and RRG_HD functions: the only copy,
-// shared by both back ends and by the file format (tsdf_io.cpp writes these bytes).
+// shared by both back ends and by the file format (tsdf_io.cpp writes Voxel records).
 //
-// Layout, 24 bytes per voxel, no padding (docs/tsdf.md):
+// On the device a voxel lives in two layers, each an array of 512 per block (DESIGN.md §3; the
+// split of Open3D's VoxelBlockGrid attributes and nvblox's layers): ray marching, normals and
+// marching cubes read only the 4-byte geometry layer, so a block's geometry is 2 KB (32 cache
+// lines) instead of the 12 KB of whole voxels; colour and reflection attributes are read once per
+// hit. The record `Voxel` (both layers, 24 bytes) is what files, host copies and tests see.
+//
+// Voxel record, 24 bytes, no padding (docs/tsdf.md):
 //   off  0 int16  tsdf     d(p)/ε in [-1, 1], fixed point × 32767 (ε/32767 ≈ 0.6 µm at ε = 2 cm)
 //   off  2 uint16 weight   W(p), number of fused observations, ≤ W_max
 //   off  4 uint16 rgb[3]   c̄(p) in [0, 1] × 65535 (16 bit: a running average over W_max = 100
@@ -17,9 +23,28 @@
 
 #include <Eigen/Core>
 
+#include <cmath>
 #include <cstdint>
 
 namespace rrg {
+
+// Geometry layer: bytes 0-3 of the record.
+struct TsdfVoxel {
+  int16_t tsdf = 0;
+  uint16_t weight = 0;
+};
+static_assert(sizeof(TsdfVoxel) == 4);
+
+// Attribute layer: bytes 4-23 of the record.
+struct AttrVoxel {
+  uint16_t rgb[3] = {0, 0, 0};
+  uint16_t n = 0;
+  float mu = 0.0f;
+  float m2 = 0.0f;
+  uint16_t r = 0;
+  uint16_t plane = 0;
+};
+static_assert(sizeof(AttrVoxel) == 20);
 
 struct Voxel {
   int16_t tsdf = 0;
@@ -32,6 +57,30 @@ struct Voxel {
   uint16_t plane = 0;
 };
 static_assert(sizeof(Voxel) == 24, "Voxel layout is part of the file format");
+
+RRG_HD inline Voxel join_voxel(const TsdfVoxel& g, const AttrVoxel& a) {
+  Voxel v;
+  v.tsdf = g.tsdf;
+  v.weight = g.weight;
+  for (int k = 0; k < 3; ++k) v.rgb[k] = a.rgb[k];
+  v.n = a.n;
+  v.mu = a.mu;
+  v.m2 = a.m2;
+  v.r = a.r;
+  v.plane = a.plane;
+  return v;
+}
+RRG_HD inline TsdfVoxel voxel_geometry(const Voxel& v) { return {v.tsdf, v.weight}; }
+RRG_HD inline AttrVoxel voxel_attributes(const Voxel& v) {
+  AttrVoxel a;
+  for (int k = 0; k < 3; ++k) a.rgb[k] = v.rgb[k];
+  a.n = v.n;
+  a.mu = v.mu;
+  a.m2 = v.m2;
+  a.r = v.r;
+  a.plane = v.plane;
+  return a;
+}
 
 struct Rgb8 {  // 8-bit colour input (as stored in PNG/JPEG)
   uint8_t r = 0, g = 0, b = 0;
@@ -47,25 +96,30 @@ namespace voxel_codec {
 inline constexpr float kTsdfScale = 32767.0f;
 inline constexpr float kUnitScale = 65535.0f;
 
-RRG_HD inline int round_to_int(float x) { return int(x >= 0.0f ? x + 0.5f : x - 0.5f); }
+inline constexpr float kInvTsdfScale = 1.0f / kTsdfScale;
+inline constexpr float kInvUnitScale = 1.0f / kUnitScale;
+
+// Branch-free on both back ends (fusion runs these for every voxel; a sign branch there is a
+// misprediction at every surface): clamp, then round half away from zero.
 RRG_HD inline int16_t encode_tsdf(float t) {  // t in [-1, 1]
-  t = t < -1.0f ? -1.0f : (t > 1.0f ? 1.0f : t);
-  return int16_t(round_to_int(t * kTsdfScale));
+  t = fminf(fmaxf(t, -1.0f), 1.0f) * kTsdfScale;
+  return int16_t(int(t + copysignf(0.5f, t)));
 }
-RRG_HD inline float decode_tsdf(int16_t q) { return float(q) / kTsdfScale; }
+RRG_HD inline float decode_tsdf(int16_t q) { return float(q) * kInvTsdfScale; }
 RRG_HD inline uint16_t encode_unit(float c) {  // c in [0, 1]
-  c = c < 0.0f ? 0.0f : (c > 1.0f ? 1.0f : c);
-  return uint16_t(round_to_int(c * kUnitScale));
+  return uint16_t(int(fminf(fmaxf(c, 0.0f), 1.0f) * kUnitScale + 0.5f));
 }
-RRG_HD inline float decode_unit(uint16_t q) { return float(q) / kUnitScale; }
+RRG_HD inline float decode_unit(uint16_t q) { return float(q) * kInvUnitScale; }
 }  // namespace voxel_codec
 
-RRG_HD inline Eigen::Vector3f voxel_color(const Voxel& v) {
+template <class V>  // Voxel or AttrVoxel
+RRG_HD inline Eigen::Vector3f voxel_color(const V& v) {
   return {voxel_codec::decode_unit(v.rgb[0]), voxel_codec::decode_unit(v.rgb[1]),
           voxel_codec::decode_unit(v.rgb[2])};
 }
 // σ_c² = M_2 / n (0 before any identification frame).
-RRG_HD inline float voxel_variance(const Voxel& v) { return v.n > 0 ? v.m2 / float(v.n) : 0.0f; }
+template <class V>
+RRG_HD inline float voxel_variance(const V& v) { return v.n > 0 ? v.m2 / float(v.n) : 0.0f; }
 
 // Block (x, y, z) holds voxels [8x, 8x + 7] × ... ; voxel g has its centre at g · s in the world.
 RRG_HD inline bool block_in_range(int x, int y, int z) {

@@ -17,7 +17,7 @@ const Intrinsics kSmallK{75.0f, 75.0f, 39.5f, 29.5f, 80, 60};
 // z-depth of the first crossing from a valid sample f > 0 to a valid sample f <= 0 at consecutive
 // steps of 0.05 voxel (in metres along the ray), bisected to 1e-6 voxel; 0 for none.
 float reference_depth(const TsdfVolume& volume, const Eigen::Vector3f& o, const Eigen::Vector3f& d) {
-  const kernel::VolumeView view{volume.hash_view(), volume.voxels(), volume.params().voxel_size};
+  const kernel::VolumeView view{volume.hash_view(), volume.geometry(), volume.attributes(), volume.params().voxel_size};
   kernel::BlockCache cache;
   const float s = volume.params().voxel_size, dz = 0.05f * s / d.norm();
   bool have_prev = false;
