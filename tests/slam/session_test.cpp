@@ -1,11 +1,7 @@
 // Session: the schedule on a small synthetic reflective sequence (real tracking, fusion, plane
 // identification and mapping on the CPU), determinism of --sync, bad input, snapshots.
 #include "core/eval/trajectory_metrics.h"
-#include "core/io/dataset.h"
-#include "core/io/synth_layout.h"
-#include "core/planes/semantic_labels.h"
-#include "core/slam/session.h"
-#include "tests/support/test_support.h"
+#include "tests/slam/session_fixture.h"
 
 #include <gtest/gtest.h>
 #include <omp.h>
@@ -17,50 +13,13 @@
 namespace rrg {
 namespace {
 
-class SessionTest : public ::testing::Test {
+class SessionTest : public test::SynthSessionTest<SessionTest, 24> {
  protected:
-  static void SetUpTestSuite() {
-    dir_ = new test::TempDir("session");
-    const auto r = test::run_rrg("synth --preset mirror_room --frames 24 --width 160 --height 120 --novel 2 --noise --out " +
-                                 (dir_->path() / "seq").string());
-    ASSERT_EQ(r.exit_code, 0) << r.output;
-  }
-  static void TearDownTestSuite() {
-    delete dir_;
-    dir_ = nullptr;
-  }
-  static std::filesystem::path root() { return dir_->path() / "seq"; }
-
-  static SessionConfig config(const io::Dataset& d) {
-    SessionConfig c;
-    c.K = d.intrinsics();
-    c.tsdf.voxel_size = 0.02f;  // a coarse map keeps the CPU test fast
-    c.tsdf.truncation = 0.08f;
-    c.tracking.mode = TrackingMode::Icp;
-    c.semantics = "labels";
-    for (const auto& [id, name] : read_category_table(io::synth_scene_file(root(), "categories.json")).names)
-      c.categories[id] = name;
-    c.sync = true;
-    c.mapping.iterations = 5;
-    return c;
-  }
-  static SessionFrame frame(const io::Dataset& d, size_t i, bool with_pose) {
-    io::Frame f = d.load(i);
-    SessionFrame s;
-    s.index = int64_t(i);
-    s.timestamp = f.timestamp;
-    s.color = std::move(f.color);
-    s.depth = std::move(f.depth);
-    s.labels = io::read_synth_labels(root(), i);
-    if (with_pose) s.pose = f.T_wc_gt->cast<float>();
-    return s;
-  }
+  static SessionConfig config(const io::Dataset& d) { return base_config(d); }
   static void run(Session& s, const io::Dataset& d, size_t n, bool poses_always) {
     for (size_t i = 0; i < n; ++i) s.process(frame(d, i, poses_always || i == 0));
   }
-  static test::TempDir* dir_;
 };
-test::TempDir* SessionTest::dir_ = nullptr;
 
 TEST_F(SessionTest, GroundTruthPosesMapAndRender) {
   const auto d = io::open_dataset(root());

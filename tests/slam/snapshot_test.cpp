@@ -2,12 +2,8 @@
 // the result must be the uninterrupted session's, bit for bit (sync mode, one CPU thread: the
 // renderer's CPU backward adds gradients with atomics, see SyncModeIsDeterministic). Also: a v1
 // file (no continuation section) still loads and continues from the last pose.
-#include "core/io/dataset.h"
-#include "core/io/synth_layout.h"
-#include "core/planes/semantic_labels.h"
-#include "core/slam/session.h"
 #include "core/tsdf/tsdf_io.h"
-#include "tests/support/test_support.h"
+#include "tests/slam/session_fixture.h"
 
 #include <gtest/gtest.h>
 #include <omp.h>
@@ -23,55 +19,23 @@ namespace {
 
 constexpr size_t kFrames = 30, kSplit = 22;  // N_o = 5: four steps before the split, 2 fused frames pending
 
-class SnapshotTest : public ::testing::Test {
+class SnapshotTest : public test::SynthSessionTest<SnapshotTest, kFrames> {
  protected:
-  static void SetUpTestSuite() {
-    dir_ = new test::TempDir("snapshot");
-    const auto r = test::run_rrg("synth --preset mirror_room --frames " + std::to_string(kFrames) +
-                                 " --width 160 --height 120 --novel 2 --noise --out " + (dir_->path() / "seq").string());
-    ASSERT_EQ(r.exit_code, 0) << r.output;
-  }
-  static void TearDownTestSuite() {
-    delete dir_;
-    dir_ = nullptr;
-  }
-  static std::filesystem::path root() { return dir_->path() / "seq"; }
-
   // Every stage that carries state across frames: ICP + masked ORB against the keyframes, plane
   // identification, reflection Gaussians, final steps over the mapper's keyframes.
   static SessionConfig config(const io::Dataset& d) {
-    SessionConfig c;
-    c.K = d.intrinsics();
-    c.tsdf.voxel_size = 0.02f;
-    c.tsdf.truncation = 0.08f;
+    SessionConfig c = base_config(d);
     c.tracking.mode = TrackingMode::IcpOrbMask;
-    c.semantics = "labels";
-    for (const auto& [id, name] : read_category_table(io::synth_scene_file(root(), "categories.json")).names)
-      c.categories[id] = name;
-    c.sync = true;
     c.plane_period = 1;    // the mirror is accepted before the split: reflection Gaussians and their Adam state
     c.mapping_period = 5;
-    c.mapping.iterations = 5;
     c.final_steps = 2;
     return c;
   }
-  static SessionFrame frame(const io::Dataset& d, size_t i) {
-    io::Frame f = d.load(i);
-    SessionFrame s;
-    s.index = int64_t(i);
-    s.timestamp = f.timestamp;
-    s.color = std::move(f.color);
-    s.depth = std::move(f.depth);
-    s.labels = io::read_synth_labels(root(), i);
-    if (i == 0) s.pose = f.T_wc_gt->cast<float>();
-    return s;
-  }
+  static SessionFrame frame(const io::Dataset& d, size_t i) { return SynthSessionTest::frame(d, i, i == 0); }
   static void run(Session& s, const io::Dataset& d, size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) s.process(frame(d, i));
   }
-  static test::TempDir* dir_;
 };
-test::TempDir* SnapshotTest::dir_ = nullptr;
 
 // One OpenMP thread while in scope (bitwise identical maps, see the file comment).
 struct OneThread {
