@@ -96,6 +96,18 @@ std::string ServiceClient::observe(const std::string& call, const std::string& s
   return server;
 }
 
+template <class Request, class Response>
+Response ServiceClient::unary(const char* call, const std::string& session, grpc::ClientContext& ctx,
+                              grpc::Status (v1::SessionService::Stub::*method)(grpc::ClientContext*, const Request&,
+                                                                               Response*),
+                              const Request& request) {
+  Response out;
+  const grpc::Status st = ((*stub_).*method)(&ctx, request, &out);
+  observe(call, session, ctx);
+  check(call, st);
+  return out;
+}
+
 v1::CreateSessionResponse ServiceClient::create(const v1::CreateSessionRequest& request) {
   grpc::ClientContext ctx;
   if (!request.session_id().empty()) ctx.AddMetadata("x-rrg-session", request.session_id());
@@ -110,29 +122,17 @@ v1::SessionInfo ServiceClient::get(const SessionHandle& s) {
   auto ctx = context(s);
   v1::GetSessionRequest r;
   r.set_session_id(s.id);
-  v1::SessionInfo out;
-  const grpc::Status st = stub_->Get(ctx.get(), r, &out);
-  observe("Get", s.id, *ctx);
-  check("Get", st);
-  return out;
+  return unary("Get", s.id, *ctx, &v1::SessionService::Stub::Get, r);
 }
 
 v1::ListSessionsResponse ServiceClient::list(const std::string& admin_key) {
   auto ctx = bearer_context(admin_key);
-  v1::ListSessionsResponse out;
-  const grpc::Status st = stub_->List(ctx.get(), {}, &out);
-  observe("List", "", *ctx);
-  check("List", st);
-  return out;
+  return unary("List", "", *ctx, &v1::SessionService::Stub::List, v1::ListSessionsRequest{});
 }
 
 v1::DrainResponse ServiceClient::drain(const std::string& admin_key) {
   auto ctx = bearer_context(admin_key);
-  v1::DrainResponse out;
-  const grpc::Status st = stub_->Drain(ctx.get(), {}, &out);
-  observe("Drain", "", *ctx);
-  check("Drain", st);
-  return out;
+  return unary("Drain", "", *ctx, &v1::SessionService::Stub::Drain, v1::DrainRequest{});
 }
 
 v1::CloseSessionResponse ServiceClient::close(const SessionHandle& s, bool save) {
@@ -140,22 +140,14 @@ v1::CloseSessionResponse ServiceClient::close(const SessionHandle& s, bool save)
   v1::CloseSessionRequest r;
   r.set_session_id(s.id);
   r.set_save(save);
-  v1::CloseSessionResponse out;
-  const grpc::Status st = stub_->Close(ctx.get(), r, &out);
-  observe("Close", s.id, *ctx);
-  check("Close", st);
-  return out;
+  return unary("Close", s.id, *ctx, &v1::SessionService::Stub::Close, r);
 }
 
 v1::SaveSessionResponse ServiceClient::save(const SessionHandle& s) {
   auto ctx = context(s);
   v1::SaveSessionRequest r;
   r.set_session_id(s.id);
-  v1::SaveSessionResponse out;
-  const grpc::Status st = stub_->Save(ctx.get(), r, &out);
-  observe("Save", s.id, *ctx);
-  check("Save", st);
-  return out;
+  return unary("Save", s.id, *ctx, &v1::SessionService::Stub::Save, r);
 }
 
 v1::CreateSessionResponse ServiceClient::load(const std::string& id, const std::string& token) {
@@ -163,21 +155,13 @@ v1::CreateSessionResponse ServiceClient::load(const std::string& id, const std::
   ctx->AddMetadata("x-rrg-session", id);
   v1::LoadSessionRequest r;
   r.set_session_id(id);
-  v1::CreateSessionResponse out;
-  const grpc::Status st = stub_->Load(ctx.get(), r, &out);
-  observe("Load", id, *ctx);
-  check("Load", st);
-  return out;
+  return unary("Load", id, *ctx, &v1::SessionService::Stub::Load, r);
 }
 
 v1::RenderViewResponse ServiceClient::render(const SessionHandle& s, v1::RenderViewRequest request) {
   auto ctx = context(s);
   if (request.session_id().empty()) request.set_session_id(s.id);
-  v1::RenderViewResponse out;
-  const grpc::Status st = stub_->RenderView(ctx.get(), request, &out);
-  observe("RenderView", s.id, *ctx);
-  check("RenderView", st);
-  return out;
+  return unary("RenderView", s.id, *ctx, &v1::SessionService::Stub::RenderView, request);
 }
 
 Blob ServiceClient::fetch(const std::string& call, const std::string& session, grpc::ClientContext& ctx,

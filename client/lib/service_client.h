@@ -111,6 +111,11 @@ class ServiceClient {
              std::unique_ptr<grpc::ClientReader<v1::DataChunk>> reader);
   // Tells the observer; returns the server's name.
   std::string observe(const std::string& call, const std::string& session, const grpc::ClientContext& ctx) const;
+  // One unary call of the stub (Stub::*method): runs it, tells the observer, throws RpcError unless OK.
+  template <class Request, class Response>
+  Response unary(const char* call, const std::string& session, grpc::ClientContext& ctx,
+                 grpc::Status (v1::SessionService::Stub::*method)(grpc::ClientContext*, const Request&, Response*),
+                 const Request& request);
   std::shared_ptr<grpc::Channel> channel_;
   std::unique_ptr<v1::SessionService::Stub> stub_;
   ServerObserver observer_;
