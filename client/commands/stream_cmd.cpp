@@ -37,7 +37,7 @@ struct StreamCmdOptions {
   io::DatasetFlags flags;
   std::vector<std::string> set;
   size_t max_frames = 0;
-  int sessions = 1, window = 4, queue = 0, progress = 10;
+  int sessions = 1, window = 4, queue = 0, progress = 10, create_retries = 5;
   bool realtime = false, preload = false, close = false, save = false, no_prior = false;
 };
 
@@ -55,6 +55,31 @@ struct SessionRun {
   std::string timings_csv;
   std::string error;
 };
+
+// Create, retried on RESOURCE_EXHAUSTED (a full server: session count or memory budget) after a
+// growing pause, up to --create-retries times. A random id is drawn afresh on each retry, so behind
+// a proxy that hashes x-rrg-session (docs/deploy.md) the retry may land on another server; an id
+// the user proposed is kept (it must stay routable to where it was asked for).
+v1::CreateSessionResponse create_with_retries(service::ServiceClient& client, v1::CreateSessionRequest create,
+                                              const StreamCmdOptions& o, const std::string& server) {
+  for (int attempt = 0;; ++attempt) {
+    try {
+      return client.create(create);
+    } catch (const service::RpcError& e) {
+      if (e.code() != grpc::StatusCode::RESOURCE_EXHAUSTED || attempt >= o.create_retries) {
+        if (e.code() == grpc::StatusCode::RESOURCE_EXHAUSTED && o.create_retries > 0)
+          throw std::runtime_error(std::string(e.what()) + " (still full after " + std::to_string(o.create_retries) +
+                                   " retries)");
+        throw;
+      }
+      const auto pause = std::chrono::milliseconds(500 * (attempt + 1));
+      spdlog::warn("stream: server {} is full ({}); retry {}/{} in {} ms", server.empty() ? o.service.server : server,
+                   e.what(), attempt + 1, o.create_retries, pause.count());
+      std::this_thread::sleep_for(pause);
+      if (o.session_id.empty()) create.set_session_id(service::new_session_id());
+    }
+  }
+}
 
 void run_stream(const StreamCmdOptions& o) {
   const auto dataset = io::open_dataset(o.dataset, o.flags.to_options());
@@ -110,7 +135,7 @@ void run_stream(const StreamCmdOptions& o) {
     else create.set_session_id(runs.size() == 1 ? o.session_id : o.session_id + "-" + std::to_string(k));
     std::string server;
     client.set_server_observer([&](const std::string&, const std::string&, const std::string& name) { server = name; });
-    const auto r = client.create(create);
+    const auto r = create_with_retries(client, create, o, server);
     runs[k].handle = {r.session_id(), r.token()};
     spdlog::info("stream: session {} on server {} via {} ({})", r.session_id(), server.empty() ? "?" : server,
                  o.service.server, r.info().device());
@@ -233,6 +258,11 @@ void register_stream_command(CLI::App& app) {
   cmd->add_option("--name", o->name, "session name");
   cmd->add_option("--session-id", o->session_id,
                   "propose the session id, [a-z0-9-]{4,64} (with --sessions N: ID-0 ... ID-N-1; default: random)");
+  cmd->add_option("--create-retries", o->create_retries,
+                  "retries of a Create that finds the server full (RESOURCE_EXHAUSTED), pausing 0.5 s, 1 s, ...; "
+                  "a random session id is drawn afresh each time")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--progress", o->progress, "log every N-th frame (0 = never)")->capture_default_str();
   cmd->add_flag("--realtime", o->realtime, "send at the dataset's frame rate (default: as fast as possible)");
   cmd->add_flag("--preload", o->preload, "encode every frame before streaming (benchmarks)");
