@@ -2,6 +2,8 @@
 // Little-endian binary serialisation for snapshot files: a growing writer and a bounds-checked
 // reader whose every read throws std::runtime_error("<what>: truncated ...") instead of reading
 // past the end. Plain trivially copyable values, strings and vectors of them.
+#include <Eigen/Geometry>
+
 #include <cstdint>
 #include <cstring>
 #include <span>
@@ -95,5 +97,17 @@ class ByteReader {
   size_t pos_ = 0;
   std::string what_;
 };
+
+// A rigid pose as its top 3x4 block, row by row (12 floats): the layout every snapshot section uses.
+inline void put_pose(ByteWriter& w, const Eigen::Isometry3f& T) {
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 4; ++j) w.put(T.matrix()(i, j));
+}
+inline Eigen::Isometry3f get_pose(ByteReader& r) {
+  Eigen::Isometry3f T = Eigen::Isometry3f::Identity();
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 4; ++j) T.matrix()(i, j) = r.get<float>();
+  return T;
+}
 
 }  // namespace rrg::io

@@ -39,17 +39,6 @@ void put_floats(io::ByteWriter& w, const float* p, size_t n) {
 }
 std::vector<float> get_floats(io::ByteReader& r) { return r.get_vector<float>(); }
 
-void put_pose(io::ByteWriter& w, const Eigen::Isometry3f& T) {
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 4; ++j) w.put(T.matrix()(i, j));
-}
-Eigen::Isometry3f get_pose(io::ByteReader& r) {
-  Eigen::Isometry3f T = Eigen::Isometry3f::Identity();
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 4; ++j) T.matrix()(i, j) = r.get<float>();
-  return T;
-}
-
 template <int N>
 void put_vecs(io::ByteWriter& w, const std::vector<Eigen::Matrix<float, N, 1>>& v) {
   put_floats(w, v.empty() ? nullptr : v[0].data(), v.size() * N);
@@ -157,14 +146,14 @@ void Session::save(const std::filesystem::path& file) const {
   w.put<uint64_t>(config.categories.size());
   for (const auto& [id, name] : config.categories) w.put<uint16_t>(id), w.put_string(name);
   w.put<int64_t>(s.frames), w.put<int64_t>(s.fused), w.put<int64_t>(s.lost), w.put<int64_t>(s.last_index);
-  put_pose(w, s.T_last);
+  io::put_pose(w, s.T_last);
   w.put<uint64_t>(s.map_version.load());
   {
     std::lock_guard lock(s.state_mutex);
     w.put<uint64_t>(s.reports.size());
     for (const FrameReport& r : s.reports) {
       w.put<int64_t>(r.index), w.put<double>(r.timestamp);
-      put_pose(w, r.T_wc);
+      io::put_pose(w, r.T_wc);
       w.put<int32_t>(int32_t(r.state)), w.put<uint8_t>(r.fused), w.put<uint8_t>(r.identified);
     }
     w.put<uint64_t>(s.reflective.size());
@@ -241,14 +230,14 @@ std::unique_ptr<Session> Session::load(const std::filesystem::path& file, std::u
   auto session = std::make_unique<Session>(config, std::move(cue));
   Impl& s = *session->impl_;
   s.frames = r.get<int64_t>(), s.fused = r.get<int64_t>(), s.lost = r.get<int64_t>(), s.last_index = r.get<int64_t>();
-  s.T_last = get_pose(r);
+  s.T_last = io::get_pose(r);
   s.map_version = r.get<uint64_t>();
   const auto nrep = r.get<uint64_t>();
   if (nrep > r.remaining()) throw std::runtime_error(what + ": corrupt report count");
   for (uint64_t i = 0; i < nrep; ++i) {
     FrameReport rep;
     rep.index = r.get<int64_t>(), rep.timestamp = r.get<double>();
-    rep.T_wc = get_pose(r);
+    rep.T_wc = io::get_pose(r);
     rep.state = TrackingState(std::clamp(r.get<int32_t>(), 0, 2));
     rep.fused = r.get<uint8_t>() != 0, rep.identified = r.get<uint8_t>() != 0;
     s.reports.push_back(rep);

@@ -44,21 +44,9 @@ std::vector<T> get_packed(io::ByteReader& r, const char* name) {
   return v;
 }
 
-void put_pose(io::ByteWriter& w, const Eigen::Isometry3f& T) {
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 4; ++j) w.put(T.matrix()(i, j));
-}
-
-Eigen::Isometry3f get_pose(io::ByteReader& r) {
-  Eigen::Isometry3f T = Eigen::Isometry3f::Identity();
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 4; ++j) T.matrix()(i, j) = r.get<float>();
-  return T;
-}
-
 void put_frame(io::ByteWriter& w, const CompactFrame& f) {
   w.put<int64_t>(f.index);
-  put_pose(w, f.T_wc);
+  io::put_pose(w, f.T_wc);
   w.put<int32_t>(f.width), w.put<int32_t>(f.height);
   put_packed(w, f.rgb);
   w.put_bytes(io::encode_rvl_zstd(f.depth, f.width, f.height, kZstdLevel));
@@ -67,7 +55,7 @@ void put_frame(io::ByteWriter& w, const CompactFrame& f) {
 CompactFrame get_frame(io::ByteReader& r) {
   CompactFrame f;
   f.index = r.get<int64_t>();
-  f.T_wc = get_pose(r);
+  f.T_wc = io::get_pose(r);
   f.width = r.get<int32_t>(), f.height = r.get<int32_t>();
   if (f.width <= 0 || f.height <= 0 || f.width > 16384 || f.height > 16384)
     throw std::runtime_error(r.what() + ": frame " + std::to_string(f.index) + " has a bad size");

@@ -8,18 +8,6 @@
 namespace rrg {
 namespace {
 
-void put_pose(io::ByteWriter& w, const Eigen::Isometry3f& T) {
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 4; ++j) w.put(T.matrix()(i, j));
-}
-
-Eigen::Isometry3f get_pose(io::ByteReader& r) {
-  Eigen::Isometry3f T = Eigen::Isometry3f::Identity();
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 4; ++j) T.matrix()(i, j) = r.get<float>();
-  return T;
-}
-
 // cv::KeyPoint as its plain fields (it is not trivially copyable on every OpenCV version).
 struct KeyPointRecord {
   float x, y, size, angle, response;
@@ -34,7 +22,7 @@ void put_keyframe(io::ByteWriter& w, const Keyframe& k) {
                                 " has inconsistent keypoints, descriptors and points");
   w.put<int32_t>(k.id);
   w.put<uint64_t>(k.frame_index);
-  put_pose(w, k.T_wc);
+  io::put_pose(w, k.T_wc);
   std::vector<KeyPointRecord> kps(n);
   for (size_t i = 0; i < n; ++i) {
     const cv::KeyPoint& p = k.keypoints[i];
@@ -54,7 +42,7 @@ Keyframe get_keyframe(io::ByteReader& r) {
   Keyframe k;
   k.id = r.get<int32_t>();
   k.frame_index = size_t(r.get<uint64_t>());
-  k.T_wc = get_pose(r);
+  k.T_wc = io::get_pose(r);
   const auto kps = r.get_vector<KeyPointRecord>();
   const auto desc = r.get_vector<uint8_t>();
   const auto xyz = r.get_vector<float>();
@@ -76,9 +64,9 @@ Keyframe get_keyframe(io::ByteReader& r) {
 
 void write_tracker_state(io::ByteWriter& w, const TrackerState& s) {
   w.put<uint8_t>(s.started);
-  put_pose(w, s.T_initial);
-  put_pose(w, s.T_prev);
-  put_pose(w, s.velocity);
+  io::put_pose(w, s.T_initial);
+  io::put_pose(w, s.T_prev);
+  io::put_pose(w, s.velocity);
   w.put<int32_t>(int32_t(s.state));
   w.put<int32_t>(s.next_keyframe_id);
   w.put<uint64_t>(s.keyframes.size());
@@ -88,9 +76,9 @@ void write_tracker_state(io::ByteWriter& w, const TrackerState& s) {
 TrackerState read_tracker_state(io::ByteReader& r) {
   TrackerState s;
   s.started = r.get<uint8_t>() != 0;
-  s.T_initial = get_pose(r);
-  s.T_prev = get_pose(r);
-  s.velocity = get_pose(r);
+  s.T_initial = io::get_pose(r);
+  s.T_prev = io::get_pose(r);
+  s.velocity = io::get_pose(r);
   const int32_t state = r.get<int32_t>();
   if (state < 0 || state > int32_t(TrackingState::Lost))
     throw std::runtime_error(r.what() + ": bad tracking state " + std::to_string(state));
