@@ -7,3 +7,24 @@
 #else
 #define RRG_HD
 #endif
+
+// RRG_INLINE: always inline a small per-sample helper into its (hot) caller. The host compiler's
+// heuristics otherwise keep e.g. the trilinear sample of the ray march an out-of-line call whose
+// results go through memory.
+#if defined(__CUDACC__)
+#define RRG_INLINE __forceinline__
+#elif defined(__GNUC__)
+#define RRG_INLINE inline __attribute__((always_inline))
+#else
+#define RRG_INLINE inline
+#endif
+
+// RRG_UNROLL: fully unroll a loop with a small constant trip count (per-voxel neighbourhood loops,
+// whose array indices then become constants).
+#if defined(__CUDACC__)
+#define RRG_UNROLL _Pragma("unroll")
+#elif defined(__GNUC__)
+#define RRG_UNROLL _Pragma("GCC unroll 32")
+#else
+#define RRG_UNROLL
+#endif

@@ -76,6 +76,7 @@ void integrate(Backend backend, const IntegrateArgs<ColorT>& a) {
   const IntegrateArgs<ColorT> args = a;
   const float inv_fx = 1.0f / a.K.fx, inv_fy = 1.0f / a.K.fy, inv_trunc = 1.0f / a.truncation;
   const Eigen::Vector3f step_x = a.R_cw.col(0) * a.voxel_size;  // camera-frame step of one voxel in x
+  const float width = float(a.pixels.width), height = float(a.pixels.height);
   // One work item per row of 8 voxels along x (a block has 64): the block's data is decoded once
   // and the camera-frame position advances by one vector add per voxel.
   parallel_for(backend, a.active.size * (kBlockVoxels / kBlockSide), [=] RRG_HD(int64_t item) {
@@ -88,9 +89,12 @@ void integrate(Backend backend, const IntegrateArgs<ColorT>& a) {
     for (int x = 0; x < kBlockSide; ++x, p_c += step_x) {
       if (!(p_c.z() > 0.0f)) continue;
       const float inv_z = 1.0f / p_c.z();  // K.project with one division
-      const int u = int(floorf(args.K.fx * p_c.x() * inv_z + args.K.cx + 0.5f));
-      const int v = int(floorf(args.K.fy * p_c.y() * inv_z + args.K.cy + 0.5f));
-      if (!args.pixels.contains(u, v)) continue;
+      // Nearest pixel: floor(x + 0.5). The range test runs on the floats (it also rejects NaN and
+      // coordinates too large for an int); on [0, size) the truncating conversion is the floor.
+      const float uf = args.K.fx * p_c.x() * inv_z + args.K.cx + 0.5f;
+      const float vf = args.K.fy * p_c.y() * inv_z + args.K.cy + 0.5f;
+      if (!(uf >= 0.0f && vf >= 0.0f && uf < width && vf < height)) continue;
+      const int u = int(uf), v = int(vf);
       const FusionPixel px = args.pixels(u, v);
       if (!(px.d > 0.0f)) continue;
       const Eigen::Vector3f P((float(u) - args.K.cx) * inv_fx * px.d, (float(v) - args.K.cy) * inv_fy * px.d, px.d);

@@ -10,6 +10,7 @@
 // the pixel lies inside the bounding rectangle of their projections.
 #include "core/common/atomics.h"
 #include "core/common/camera.h"
+#include "core/common/fast_math.h"
 #include "core/common/span.h"
 #include "core/tsdf/voxel.h"
 
@@ -74,25 +75,25 @@ RRG_HD inline void range_splat_block(const RangeImage& r, uint64_t key, float vo
   for (int c = 0; c < 8; ++c) {
     const Eigen::Vector3f p = lo + side * Eigen::Vector3f(float(c & 1), float((c >> 1) & 1), float(c >> 2));
     const Eigen::Vector3f q = R_cw * p + t_cw;
-    z_lo = fminf(z_lo, q.z());
-    z_hi = fmaxf(z_hi, q.z());
+    z_lo = min_f(z_lo, q.z());
+    z_hi = max_f(z_hi, q.z());
     if (q.z() <= 1e-4f) {
       behind = true;
       continue;
     }
     const Eigen::Vector2f uv = K.project(q);
-    u_lo = fminf(u_lo, uv.x());
-    u_hi = fmaxf(u_hi, uv.x());
-    v_lo = fminf(v_lo, uv.y());
-    v_hi = fmaxf(v_hi, uv.y());
+    u_lo = min_f(u_lo, uv.x());
+    u_hi = max_f(u_hi, uv.x());
+    v_lo = min_f(v_lo, uv.y());
+    v_hi = max_f(v_hi, uv.y());
   }
   if (z_hi < min_depth || z_lo > max_depth) return;
-  z_lo = fmaxf(z_lo, min_depth);
+  z_lo = max_f(z_lo, min_depth);
   int tx0 = 0, ty0 = 0, tx1 = r.tiles_x - 1, ty1 = r.tiles_y - 1;
   if (!behind) {  // one pixel of slack for rounding
     if (u_hi < -1.0f || v_hi < -1.0f || u_lo > float(K.width) || v_lo > float(K.height)) return;
     const auto tile = [](float u, int n) {  // clamped before the conversion (u may be huge)
-      return int(fminf(fmaxf(floorf(u / float(kRangeTile)), 0.0f), float(n - 1)));
+      return floor_to_int(min_f(max_f(u / float(kRangeTile), 0.0f), float(n - 1)));
     };
     tx0 = tile(u_lo - 1.0f, r.tiles_x);
     ty0 = tile(v_lo - 1.0f, r.tiles_y);

@@ -2,13 +2,14 @@
 // Per-pixel raycasting math (pass 1 of the renderer, DESIGN.md §1): zero-crossing search along the
 // ray with block-level empty-space skipping, secant refinement, and the outputs at the surface.
 #include "core/common/camera.h"
+#include "core/common/fast_math.h"
 #include "core/tsdf/tsdf_integrate_device.h"
 #include "core/tsdf/tsdf_sample_device.h"
 
 namespace rrg::kernel {
 
 inline constexpr int kRefineSteps = 8;     // at most, per hit
-inline constexpr float kRefineTol = 1e-3f;  // stop when the bracket is shorter (voxels)
+inline constexpr float kRefineTol = 1e-3f;  // stop when the bracket or |d| is smaller (voxels)
 
 struct RayHit {
   bool hit = false;
@@ -16,46 +17,52 @@ struct RayHit {
   Eigen::Vector3f p_w = Eigen::Vector3f::Zero();
 };
 
-// Distance (in units of the ray parameter) to leave the block region [8b, 8b + 8) · s that holds
-// p along dir. A trilinear sample at p needs its lower corner voxel floor(p / s), so no point of the
-// region of an unallocated block has a valid sample.
-RRG_HD inline float block_exit(const Eigen::Vector3f& p, const Eigen::Vector3f& dir, float voxel_size) {
+// Distance (in units of the ray parameter) to leave the region [8b, 8b + 8) · s of block b that
+// holds p, along dir (inv_dir = 1 / dir per axis, ±inf on an axis the ray does not move along). A
+// trilinear sample at p needs its lower corner voxel floor(p / s), so no point of the region of an
+// unallocated block has a valid sample.
+RRG_HD inline float block_exit(const Eigen::Vector3f& p, const Eigen::Vector3f& dir, const Eigen::Vector3f& inv_dir,
+                               const Eigen::Vector3i& b, float voxel_size) {
   const float block_size = voxel_size * kBlockSide;
   float t_exit = 1e30f;
   for (int k = 0; k < 3; ++k) {
     if (dir[k] == 0.0f) continue;
-    const float lo = floorf(p[k] / block_size) * block_size, hi = lo + block_size;
-    const float t = ((dir[k] > 0.0f ? hi : lo) - p[k]) / dir[k];
-    t_exit = fminf(t_exit, t);
+    const float face = float(dir[k] > 0.0f ? b[k] + 1 : b[k]) * block_size;
+    t_exit = min_f(t_exit, (face - p[k]) * inv_dir[k]);
   }
-  return fmaxf(t_exit, 0.0f);
+  return max_f(t_exit, 0.0f);
 }
 
 // March from depth z_start to z_end along o + z · d (d has unit z in the camera frame) and return
-// the first +/− zero crossing of the trilinear TSDF, refined by regula falsi. Steps:
+// the first +/− zero crossing of the trilinear TSDF, refined by regula falsi until the bracket or
+// the sample's own distance |d| is below kRefineTol voxels. `cache` holds the blocks looked up
+// (shade() of the hit reuses them). Steps:
 //   block of floor(p / s) not allocated       → to the ray's exit from that block (DDA over blocks);
 //   sample invalid (a corner unobserved)      → one voxel;
 //   f = d/ε > 0                               → max(s, 0.8 · f · ε) (the TSDF is a distance bound);
 //   f ≤ 0 without a positive sample before    → one voxel (entering from behind a surface).
 RRG_HD inline RayHit march(const VolumeView& vol, const Eigen::Vector3f& o, const Eigen::Vector3f& d,
-                           float truncation, float z_start, float z_end) {
+                           float truncation, float z_start, float z_end, BlockCache& cache) {
   RayHit hit;
-  BlockCache cache;
   const float len = d.norm();           // metres per unit of z
-  const float s = vol.voxel_size;
+  const float s = vol.voxel_size, inv_s = 1.0f / s;
+  const Eigen::Vector3f inv_d(1.0f / d.x(), 1.0f / d.y(), 1.0f / d.z());
+  const float voxel_z = s / len, nudge_z = 1e-3f * s / len;  // one voxel, 1/1000 voxel along the ray
   float z = z_start, z_prev = 0.0f, f_prev = 0.0f;
   bool have_prev = false;
   while (z < z_end) {
     const Eigen::Vector3f p = o + z * d;
-    const Eigen::Vector3i g(int(floorf(p.x() / s)), int(floorf(p.y() / s)), int(floorf(p.z() / s)));
-    if (voxel_at(vol, g, cache) < 0) {  // empty space: skip the whole block
-      z += block_exit(p, d, s) + 1e-3f * s / len;
+    float f = 0.0f;
+    const Sample sample = sample_tsdf_at(vol, p, cache, f);
+    if (sample == Sample::NoBlock) {  // empty space: skip the whole block
+      const Eigen::Vector3f q = p * inv_s;
+      const Eigen::Vector3i b(block_of(floor_to_int(q.x())), block_of(floor_to_int(q.y())), block_of(floor_to_int(q.z())));
+      z += block_exit(p, d, inv_d, b, s) + nudge_z;
       have_prev = false;
       continue;
     }
-    float f;
-    if (!sample_tsdf(vol, p, cache, f)) {
-      z += s / len;
+    if (sample == Sample::Unobserved) {
+      z += voxel_z;
       have_prev = false;
       continue;
     }
@@ -68,6 +75,7 @@ RRG_HD inline RayHit march(const VolumeView& vol, const Eigen::Vector3f& o, cons
       for (int it = 0; it < kRefineSteps && (zb - za) * len > kRefineTol * s; ++it) {
         float fc;
         if (!sample_tsdf(vol, o + zc * d, cache, fc)) break;
+        if (fabsf(fc) * truncation <= kRefineTol * s) break;  // |d| bounds the distance to the surface
         if (fc > 0.0f) {
           za = zc;
           fa = fc;
@@ -90,8 +98,7 @@ RRG_HD inline RayHit march(const VolumeView& vol, const Eigen::Vector3f& o, cons
     have_prev = true;
     z_prev = z;
     f_prev = f;
-    const float step = f > 0.0f ? fmaxf(s, 0.8f * f * truncation) : s;  // metres
-    z += step / len;
+    z += f > 0.0f ? max_f(voxel_z, 0.8f * f * truncation / len) : voxel_z;
   }
   return hit;
 }
@@ -104,53 +111,76 @@ struct SurfaceSample {
   int32_t plane = 0;         // π of the nearest voxel, canonical through the remap table
 };
 
-// The voxels base + (−1..2)³ around the cell of a surface point: the 8 corners of the cell and the
-// 24 further voxels the central differences of the trilinear TSDF one voxel apart need. Their
-// blocks (at most two per axis) are resolved once, so the normal costs 32 voxel reads instead of
-// six full trilinear samples.
+// The voxels g + (−1..2)³ around the cell g .. g + 1 of a surface point: the 8 corners of the cell
+// and the 24 further voxels the central differences of the trilinear TSDF one voxel apart need.
+// Their blocks (at most two per axis) are resolved once, and per axis the block (0 or 1) and the
+// in-block offset of each of the four coordinates are tabulated, so a read costs a few adds.
 struct Neighbourhood {
   const VolumeView& vol;
-  Eigen::Vector3i lo;  // voxel base − 1
-  int64_t first[8];    // voxel 0 of block (lo block + bit offsets), −1 when not resident
-  // Pool index of voxel lo + (x, y, z), x, y, z in 0..3; −1 when missing or unobserved.
-  RRG_HD int64_t at(int x, int y, int z) const {
-    const int gx = lo.x() + x, gy = lo.y() + y, gz = lo.z() + z;
-    const int o = (block_of(gx) - block_of(lo.x())) | ((block_of(gy) - block_of(lo.y())) << 1) |
-                  ((block_of(gz) - block_of(lo.z())) << 2);
-    if (first[o] < 0) return -1;
-    const int64_t v = first[o] + local_index(local_of(gx), local_of(gy), local_of(gz));
+  int64_t first[8];   // voxel 0 of block (block of g − 1) + (bit 0: +x, 1: +y, 2: +z); −1 when not resident
+  int block[3][4];    // per axis k, coordinate g − 1 + i: 0 in the first block, 2^k in the next
+  int offset[3][4];   // per axis: local coordinate × stride (1, 8, 64)
+  // Pool index of voxel g − 1 + (x, y, z), x, y, z in 0..3; −1 when missing or unobserved.
+  RRG_HD RRG_INLINE int64_t at(int x, int y, int z) const {
+    const int64_t b = first[block[0][x] | block[1][y] | block[2][z]];
+    if (b < 0) return -1;
+    const int64_t v = b + offset[0][x] + offset[1][y] + offset[2][z];
     return vol.geometry[v].weight > 0 ? v : -1;
   }
 };
 
-// Attributes at a surface point p (trilinear, as the supplement's C_var).
-RRG_HD inline SurfaceSample shade(const VolumeView& vol, const Eigen::Vector3f& p, Span<const int32_t> remap) {
+// Attributes at a surface point p (trilinear, as the supplement's C_var). `cache` may hold blocks
+// from the march.
+RRG_HD inline SurfaceSample shade(const VolumeView& vol, const Eigen::Vector3f& p, Span<const int32_t> remap,
+                                  BlockCache& cache) {
   constexpr float kEps = 1e-6f;
   SurfaceSample out;
-  BlockCache cache;
-  const float s = vol.voxel_size;
-  const Eigen::Vector3f q = p / s;
-  const Eigen::Vector3f b(floorf(q.x()), floorf(q.y()), floorf(q.z()));
-  const Eigen::Vector3f f = q - b;
-  Neighbourhood nb{vol, Eigen::Vector3i(int(b.x()) - 1, int(b.y()) - 1, int(b.z()) - 1), {}};
-  const int bx = block_of(nb.lo.x()), by = block_of(nb.lo.y()), bz = block_of(nb.lo.z());
-  const int ex = block_of(nb.lo.x() + 3) - bx, ey = block_of(nb.lo.y() + 3) - by, ez = block_of(nb.lo.z() + 3) - bz;
+  const Eigen::Vector3f q = p * (1.0f / vol.voxel_size);
+  const Eigen::Vector3i g(floor_to_int(q.x()), floor_to_int(q.y()), floor_to_int(q.z()));
+  const Eigen::Vector3f f = q - g.cast<float>();
+  Neighbourhood nb{vol, {}, {}, {}};
+  int b_lo[3], span[3];  // block of g − 1 per axis; whether g + 2 is in the next block
+  RRG_UNROLL
+  for (int k = 0; k < 3; ++k) {
+    const int lo = g[k] - 1, stride = k == 0 ? 1 : (k == 1 ? kBlockSide : kBlockSide * kBlockSide);
+    b_lo[k] = block_of(lo);
+    RRG_UNROLL
+    for (int i = 0; i < 4; ++i) {
+      nb.block[k][i] = (block_of(lo + i) - b_lo[k]) << k;
+      nb.offset[k][i] = local_of(lo + i) * stride;
+    }
+    span[k] = nb.block[k][3] >> k;
+  }
+  RRG_UNROLL
   for (int o = 0; o < 8; ++o) {
     const int dx = o & 1, dy = (o >> 1) & 1, dz = o >> 2;
     nb.first[o] = -1;
-    if (dx > ex || dy > ey || dz > ez) continue;
-    const int32_t blk = cached_block(vol, bx + dx, by + dy, bz + dz, cache);
+    if (dx > span[0] || dy > span[1] || dz > span[2]) continue;
+    const int32_t blk = cached_block(vol, b_lo[0] + dx, b_lo[1] + dy, b_lo[2] + dz, cache);
     if (blk >= 0) nb.first[o] = int64_t(blk) * kBlockVoxels;
   }
-  // The cell's corners (offset 1 in the neighbourhood) and their trilinear weights.
+  // d/ε of the cell's corners (neighbourhood coordinates 1..2) and of each corner's outward face
+  // neighbour along each axis (that coordinate 0 or 3): the 32 voxels the normal needs, read once.
+  float tc[8], tn[3][8];
   int64_t corner[8];
-  float w[8];
+  RRG_UNROLL
+  for (int c = 0; c < 8; ++c) {
+    corner[c] = nb.at(1 + (c & 1), 1 + ((c >> 1) & 1), 1 + (c >> 2));
+    if (corner[c] < 0) return out;  // a corner of the cell unobserved: no trilinear value here
+    tc[c] = voxel_codec::decode_tsdf(vol.geometry[corner[c]].tsdf);
+  }
+  bool neighbours = true;  // all 24 outward neighbours observed
+  RRG_UNROLL
   for (int c = 0; c < 8; ++c) {
     const int dx = c & 1, dy = (c >> 1) & 1, dz = c >> 2;
-    corner[c] = nb.at(1 + dx, 1 + dy, 1 + dz);
-    if (corner[c] < 0) return out;
-    w[c] = (dx ? f.x() : 1.0f - f.x()) * (dy ? f.y() : 1.0f - f.y()) * (dz ? f.z() : 1.0f - f.z());
+    const int64_t v[3] = {nb.at(3 * dx, 1 + dy, 1 + dz), nb.at(1 + dx, 3 * dy, 1 + dz), nb.at(1 + dx, 1 + dy, 3 * dz)};
+    for (int k = 0; k < 3; ++k) {
+      neighbours = neighbours && v[k] >= 0;
+      tn[k][c] = v[k] >= 0 ? voxel_codec::decode_tsdf(vol.geometry[v[k]].tsdf) : 0.0f;
+    }
   }
+  float w[8];
+  for (int c = 0; c < 8; ++c) w[c] = corner_weight(f, c);
   float w_refl = 0.0f;
   for (int i = 0; i < 8; ++i) {
     const AttrVoxel& a = vol.attributes[corner[i]];
@@ -170,28 +200,19 @@ RRG_HD inline SurfaceSample shade(const VolumeView& vol, const Eigen::Vector3f& 
   //   f(p + s e_k) − f(p − s e_k) = Σ_c w_c (d(c + e_k) − d(c − e_k)),
   // when all 24 voxels beyond the cell are observed; within the cell otherwise.
   Eigen::Vector3f grad = Eigen::Vector3f::Zero();
-  bool ok = true;
-  for (int k = 0; k < 3 && ok; ++k)
-    for (int c = 0; c < 8 && ok; ++c) {
-      int x = 1 + (c & 1), y = 1 + ((c >> 1) & 1), z = 1 + (c >> 2);
-      int xp = x, yp = y, zp = z, xm = x, ym = y, zm = z;
-      if (k == 0) ++xp, --xm;
-      if (k == 1) ++yp, --ym;
-      if (k == 2) ++zp, --zm;
-      const int64_t vp = nb.at(xp, yp, zp), vm = nb.at(xm, ym, zm);
-      if (vp < 0 || vm < 0) {
-        ok = false;
-        break;
+  if (neighbours) {  // along axis k, corner c's other neighbour is the corner c ^ 2^k
+    RRG_UNROLL
+    for (int c = 0; c < 8; ++c)
+      RRG_UNROLL
+      for (int k = 0; k < 3; ++k) {
+        const int bit = 1 << k;
+        grad[k] += w[c] * ((c & bit) ? tn[k][c] - tc[c ^ bit] : tc[c ^ bit] - tn[k][c]);
       }
-      grad[k] += w[c] * (voxel_codec::decode_tsdf(vol.geometry[vp].tsdf) - voxel_codec::decode_tsdf(vol.geometry[vm].tsdf));
-    }
-  if (!ok) {  // gradient of the trilinear interpolant inside the cell
-    float t[8];
-    for (int i = 0; i < 8; ++i) t[i] = voxel_codec::decode_tsdf(vol.geometry[corner[i]].tsdf);
+  } else {  // gradient of the trilinear interpolant inside the cell
     const auto lerp = [](float a, float b, float u) { return a + (b - a) * u; };
-    grad.x() = lerp(lerp(t[1] - t[0], t[3] - t[2], f.y()), lerp(t[5] - t[4], t[7] - t[6], f.y()), f.z());
-    grad.y() = lerp(lerp(t[2] - t[0], t[3] - t[1], f.x()), lerp(t[6] - t[4], t[7] - t[5], f.x()), f.z());
-    grad.z() = lerp(lerp(t[4] - t[0], t[5] - t[1], f.x()), lerp(t[6] - t[2], t[7] - t[3], f.x()), f.y());
+    grad.x() = lerp(lerp(tc[1] - tc[0], tc[3] - tc[2], f.y()), lerp(tc[5] - tc[4], tc[7] - tc[6], f.y()), f.z());
+    grad.y() = lerp(lerp(tc[2] - tc[0], tc[3] - tc[1], f.x()), lerp(tc[6] - tc[4], tc[7] - tc[5], f.x()), f.z());
+    grad.z() = lerp(lerp(tc[4] - tc[0], tc[5] - tc[1], f.x()), lerp(tc[6] - tc[2], tc[7] - tc[3], f.x()), f.y());
   }
   const float n = grad.norm();
   if (n > 0.0f) out.normal = grad / n;

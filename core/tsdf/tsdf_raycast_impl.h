@@ -1,6 +1,7 @@
 #pragma once
 // The body of raycast() (tsdf_raycast.h), templated on the back-end tag; instantiated by
 // tsdf_raycast_cpu.cpp and tsdf_raycast_cuda.cu.
+#include "core/common/parallel_for.h"
 #include "core/tsdf/tsdf_range_device.h"
 #include "core/tsdf/tsdf_raycast_device.h"
 
@@ -23,6 +24,17 @@ struct RaycastArgs {
   ImageView<float> variance;
 };
 
+// Pixels per work item of the march: a row of a range tile on the CPU (one thread walks it with one
+// block cache), one pixel per GPU thread.
+template <class Backend>
+struct RaycastRun {
+  static constexpr int value = 1;
+};
+template <>
+struct RaycastRun<CpuBackend> {
+  static constexpr int value = kRangeTile;
+};
+
 // Three passes: clear the range image, splat every resident block into it, march every pixel
 // within its tile's [near, far] (tsdf_range_device.h).
 template <class Backend>
@@ -38,32 +50,39 @@ void raycast(Backend backend, const RaycastArgs& a) {
                       args.min_depth, args.max_depth);
   });
   // Pixels in range-tile order (kRangeTile² consecutive indices per tile): neighbouring rays meet
-  // the same blocks, so they share cache lines on the CPU and memory transactions on the GPU.
+  // the same blocks, so they share cache lines on the CPU and memory transactions on the GPU. A work
+  // item marches a run of RaycastRun consecutive pixels with one block cache, so the run's rays
+  // find most blocks in it instead of the hash table.
   const int h = a.depth.height;
+  constexpr int run = RaycastRun<Backend>::value;
   const int64_t tile_px = int64_t(kRangeTile) * kRangeTile;
-  parallel_for(backend, int64_t(a.range.tiles_x) * a.range.tiles_y * tile_px, [=] RRG_HD(int64_t j) {
-    const int64_t t = j / tile_px, k = j % tile_px;
-    const int xi = int(t % args.range.tiles_x) * kRangeTile + int(k % kRangeTile);
-    const int yi = int(t / args.range.tiles_x) * kRangeTile + int(k / kRangeTile);
-    if (xi >= w || yi >= h) return;
-    const int64_t i = int64_t(yi) * w + xi;
-    float near, far;
-    range_at(args.range, xi, yi, near, far);
-    const Eigen::Vector3f d = args.R_wc * args.K.unproject(float(xi), float(yi), 1.0f);
-    RayHit hit;
-    if (near <= far)  // a little slack on the far end for rounding in the splat
-      hit = march(args.volume, args.t_wc, d, args.truncation, fmaxf(near, args.min_depth),
-                  fminf(far + 0.01f * args.volume.voxel_size, args.max_depth));
-    SurfaceSample s;
-    if (hit.hit) s = shade(args.volume, hit.p_w, args.remap);
-    args.depth[i] = hit.hit ? hit.z : 0.0f;
-    args.vertices[i] = hit.p_w;
-    args.normals[i] = s.normal;
-    args.colors[i] = s.color;
-    args.plane_ids[i] = s.plane;
-    args.reflection[i] = s.reflection;
-    args.mask[i] = s.reflection > 0.5f ? 1 : 0;
-    args.variance[i] = s.variance;
+  parallel_for(backend, int64_t(a.range.tiles_x) * a.range.tiles_y * tile_px / run, [=] RRG_HD(int64_t item) {
+    BlockCache cache;
+    for (int r = 0; r < run; ++r) {
+      const int64_t j = item * run + r;
+      const int64_t t = j / tile_px, k = j % tile_px;
+      const int xi = int(t % args.range.tiles_x) * kRangeTile + int(k % kRangeTile);
+      const int yi = int(t / args.range.tiles_x) * kRangeTile + int(k / kRangeTile);
+      if (xi >= w || yi >= h) continue;
+      const int64_t i = int64_t(yi) * w + xi;
+      float near, far;
+      range_at(args.range, xi, yi, near, far);
+      const Eigen::Vector3f d = args.R_wc * args.K.unproject(float(xi), float(yi), 1.0f);
+      RayHit hit;
+      if (near <= far)  // a little slack on the far end for rounding in the splat
+        hit = march(args.volume, args.t_wc, d, args.truncation, max_f(near, args.min_depth),
+                    min_f(far + 0.01f * args.volume.voxel_size, args.max_depth), cache);
+      SurfaceSample s;
+      if (hit.hit) s = shade(args.volume, hit.p_w, args.remap, cache);
+      args.depth[i] = hit.hit ? hit.z : 0.0f;
+      args.vertices[i] = hit.p_w;
+      args.normals[i] = s.normal;
+      args.colors[i] = s.color;
+      args.plane_ids[i] = s.plane;
+      args.reflection[i] = s.reflection;
+      args.mask[i] = s.reflection > 0.5f ? 1 : 0;
+      args.variance[i] = s.variance;
+    }
   });
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 // Reading the volume at world points: voxel lookup through the hash (with a one-block cache) and
 // trilinear interpolation over the 8 voxels around a point. Shared by raycasting and tests.
+#include "core/common/fast_math.h"
 #include "core/tsdf/voxel_hash_device.h"
 
 #include <Eigen/Core>
@@ -26,9 +27,10 @@ struct BlockCache {
 };
 
 // Pool index of the block with coordinates (bx, by, bz), or -1 when it is not resident.
-RRG_HD inline int32_t cached_block(const VolumeView& vol, int bx, int by, int bz, BlockCache& cache) {
+RRG_HD RRG_INLINE int32_t cached_block(const VolumeView& vol, int bx, int by, int bz, BlockCache& cache) {
   if (!block_in_range(bx, by, bz)) return -1;
   const uint64_t key = block_key(bx, by, bz);
+  RRG_UNROLL
   for (int e = 0; e < BlockCache::kEntries; ++e)
     if (cache.key[e] == key) return cache.block[e];
   const int32_t b = hash_find(vol.hash, key);
@@ -38,59 +40,90 @@ RRG_HD inline int32_t cached_block(const VolumeView& vol, int bx, int by, int bz
   return b;
 }
 
-// Pool index of the voxel with global coordinates g (centre at g · s), or -1 when its block is not
-// resident.
-RRG_HD inline int64_t voxel_at(const VolumeView& vol, const Eigen::Vector3i& g, BlockCache& cache) {
-  const int32_t b = cached_block(vol, block_of(g.x()), block_of(g.y()), block_of(g.z()), cache);
-  if (b < 0) return -1;
-  return int64_t(b) * kBlockVoxels + local_index(local_of(g.x()), local_of(g.y()), local_of(g.z()));
-}
-
-// The 8 voxels around p (pool indices) and their trilinear weights w_i; false when one is missing
-// or unobserved.
-struct Corners {
-  int64_t v[8];
-  float w[8];
+// Trilinear sampling at p: the cell of p is the voxels g .. g + 1 with g = floor(p / s) (its lower
+// corner), p = (g + f) · s with f in [0, 1)³.
+enum class Sample {
+  NoBlock,     // the block of the lower corner g is not resident: nothing valid nearby
+  Unobserved,  // a corner is in a missing block or has weight 0
+  Valid,
 };
-RRG_HD inline bool trilinear_corners(const VolumeView& vol, const Eigen::Vector3f& p_w, BlockCache& cache,
-                                     Corners& out) {
-  const Eigen::Vector3f q = p_w / vol.voxel_size;
-  const Eigen::Vector3f b(floorf(q.x()), floorf(q.y()), floorf(q.z()));
-  const Eigen::Vector3f f = q - b;
-  const Eigen::Vector3i base(int(b.x()), int(b.y()), int(b.z()));
-  const int lx = local_of(base.x()), ly = local_of(base.y()), lz = local_of(base.z());
-  // The corners lie in the base voxel's block and, where a local coordinate is 7, in its +x / +y / +z
-  // neighbours: each of those blocks is looked up once, through the cache.
+
+// The TSDF values of the 8 voxels around p (corner c = dx + 2 dy + 4 dz) in fixed-point units
+// (d/ε × voxel_codec::kTsdfScale: scaled once after interpolating) and p's position f in the cell.
+struct Corners {
+  float t[8];
+  Eigen::Vector3f f;
+};
+
+RRG_HD RRG_INLINE Sample trilinear_corners(const VolumeView& vol, const Eigen::Vector3f& p_w, BlockCache& cache,
+                                       Corners& out) {
+  const Eigen::Vector3f q = p_w * (1.0f / vol.voxel_size);
+  const int gx = floor_to_int(q.x()), gy = floor_to_int(q.y()), gz = floor_to_int(q.z());
+  out.f = Eigen::Vector3f(q.x() - float(gx), q.y() - float(gy), q.z() - float(gz));
+  const int lx = local_of(gx), ly = local_of(gy), lz = local_of(gz);
+  const int bx = block_of(gx), by = block_of(gy), bz = block_of(gz);
+  const int32_t b0 = cached_block(vol, bx, by, bz, cache);
+  if (b0 < 0) return Sample::NoBlock;
+  const int64_t v0 = int64_t(b0) * kBlockVoxels + local_index(lx, ly, lz);
+  int unobserved = 0;
+  if (lx < kBlockSide - 1 && ly < kBlockSide - 1 && lz < kBlockSide - 1) {
+    // The whole cell in one block (7/8 of the cells per axis): fixed offsets from the lower corner.
+    RRG_UNROLL
+    for (int c = 0; c < 8; ++c) {
+      const int64_t v = v0 + local_index(c & 1, (c >> 1) & 1, c >> 2);
+      const TsdfVoxel g = vol.geometry[v];
+      unobserved |= int(g.weight == 0);
+      out.t[c] = float(g.tsdf);
+    }
+    return unobserved ? Sample::Unobserved : Sample::Valid;
+  }
+  // The cell straddles blocks: where a local coordinate is 7, the corners one further lie in the
+  // +x / +y / +z neighbour; each of those blocks is looked up once, through the cache.
   const bool ox = lx == kBlockSide - 1, oy = ly == kBlockSide - 1, oz = lz == kBlockSide - 1;
-  int64_t first[8] = {};  // voxel 0 of each neighbouring block (bit 0: +x, 1: +y, 2: +z)
-  const int bx = block_of(base.x()), by = block_of(base.y()), bz = block_of(base.z());
-  for (int o = 0; o < 8; ++o) {
-    const int dx = o & 1, dy = (o >> 1) & 1, dz = o >> 2;
-    if ((dx && !ox) || (dy && !oy) || (dz && !oz)) continue;
-    const int32_t b = cached_block(vol, bx + dx, by + dy, bz + dz, cache);
-    if (b < 0) return false;
+  const int crossing = int(ox) | (int(oy) << 1) | (int(oz) << 2);
+  int64_t first[8] = {int64_t(b0) * kBlockVoxels};  // voxel 0 of each block (bit 0: +x, 1: +y, 2: +z)
+  for (int o = 1; o < 8; ++o) {
+    if (o & ~crossing) continue;  // no corner in that neighbour
+    const int32_t b = cached_block(vol, bx + (o & 1), by + ((o >> 1) & 1), bz + (o >> 2), cache);
+    if (b < 0) return Sample::Unobserved;
     first[o] = int64_t(b) * kBlockVoxels;
   }
+  RRG_UNROLL
   for (int c = 0; c < 8; ++c) {
-    const int dx = c & 1, dy = (c >> 1) & 1, dz = c >> 2;
-    const int x = lx + dx, y = ly + dy, z = lz + dz;
+    const int x = lx + (c & 1), y = ly + ((c >> 1) & 1), z = lz + (c >> 2);
     const int o = (x >> 3) | ((y >> 3) << 1) | ((z >> 3) << 2);
     const int64_t v = first[o] + local_index(x & 7, y & 7, z & 7);
-    if (vol.geometry[v].weight == 0) return false;
-    out.v[c] = v;
-    out.w[c] = (dx ? f.x() : 1.0f - f.x()) * (dy ? f.y() : 1.0f - f.y()) * (dz ? f.z() : 1.0f - f.z());
+    const TsdfVoxel g = vol.geometry[v];
+    unobserved |= int(g.weight == 0);
+    out.t[c] = float(g.tsdf);
   }
-  return true;
+  return unobserved ? Sample::Unobserved : Sample::Valid;
+}
+
+// Trilinear weight of corner c at f.
+RRG_HD inline float corner_weight(const Eigen::Vector3f& f, int c) {
+  return ((c & 1) ? f.x() : 1.0f - f.x()) * ((c & 2) ? f.y() : 1.0f - f.y()) * ((c & 4) ? f.z() : 1.0f - f.z());
+}
+
+// The trilinear interpolant of the corner values at f (x, then y, then z).
+RRG_HD inline float trilinear(const float t[8], const Eigen::Vector3f& f) {
+  const auto lerp = [](float a, float b, float u) { return a + (b - a) * u; };
+  const float y0 = lerp(lerp(t[0], t[1], f.x()), lerp(t[2], t[3], f.x()), f.y());
+  const float y1 = lerp(lerp(t[4], t[5], f.x()), lerp(t[6], t[7], f.x()), f.y());
+  return lerp(y0, y1, f.z());
+}
+
+// Normalised TSDF d/ε at p (trilinear) and whether it could be formed.
+RRG_HD RRG_INLINE Sample sample_tsdf_at(const VolumeView& vol, const Eigen::Vector3f& p_w, BlockCache& cache, float& out) {
+  Corners c;
+  const Sample r = trilinear_corners(vol, p_w, cache, c);
+  if (r == Sample::Valid) out = trilinear(c.t, c.f) * voxel_codec::kInvTsdfScale;
+  return r;
 }
 
 // Normalised TSDF d/ε at p (trilinear); false where not all 8 voxels are observed.
-RRG_HD inline bool sample_tsdf(const VolumeView& vol, const Eigen::Vector3f& p_w, BlockCache& cache, float& out) {
-  Corners c;
-  if (!trilinear_corners(vol, p_w, cache, c)) return false;
-  float f = 0.0f;
-  for (int i = 0; i < 8; ++i) f += c.w[i] * voxel_codec::decode_tsdf(vol.geometry[c.v[i]].tsdf);
-  out = f;
-  return true;
+RRG_HD RRG_INLINE bool sample_tsdf(const VolumeView& vol, const Eigen::Vector3f& p_w, BlockCache& cache, float& out) {
+  return sample_tsdf_at(vol, p_w, cache, out) == Sample::Valid;
 }
 
 }  // namespace rrg::kernel

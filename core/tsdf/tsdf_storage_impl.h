@@ -29,8 +29,8 @@ struct TouchArgs {
 // Visits the blocks crossed by the segment a -> b (block units: block = floor(q)), Amanatides-Woo.
 template <class F>
 RRG_HD void for_blocks_on_segment(const Eigen::Vector3f& a, const Eigen::Vector3f& b, F visit) {
-  Eigen::Vector3i cell(int(floorf(a.x())), int(floorf(a.y())), int(floorf(a.z())));
-  const Eigen::Vector3i last(int(floorf(b.x())), int(floorf(b.y())), int(floorf(b.z())));
+  Eigen::Vector3i cell(floor_to_int(a.x()), floor_to_int(a.y()), floor_to_int(a.z()));
+  const Eigen::Vector3i last(floor_to_int(b.x()), floor_to_int(b.y()), floor_to_int(b.z()));
   const Eigen::Vector3f d = b - a;
   Eigen::Vector3i step;
   Eigen::Vector3f t_max, t_delta;
@@ -81,7 +81,7 @@ void touch_blocks(Backend backend, const TouchArgs& a) {
     for (int x = x0; x < x1; ++x) {
       const float d = args.depth(x, y);
       if (!(d >= args.min_depth && d <= args.max_depth)) continue;
-      const float d0 = fmaxf(d - args.truncation, 1e-3f), d1 = d + args.truncation;
+      const float d0 = max_f(d - args.truncation, 1e-3f), d1 = d + args.truncation;
       const Eigen::Vector3f p0 = args.R_wc * args.K.unproject(float(x), float(y), d0) + args.t_wc;
       const Eigen::Vector3f p1 = args.R_wc * args.K.unproject(float(x), float(y), d1) + args.t_wc;
       const Eigen::Vector3f q0 = p0 * to_block + Eigen::Vector3f::Constant(half);

@@ -19,6 +19,7 @@
 //   off 16 float  m2       M_2, second central moment of x;  σ_c² = M_2 / n
 //   off 20 uint16 r        reflection strength r(p) in [0, 1] × 65535
 //   off 22 uint16 plane    plane id π(p), canonical at fusion time, 0 = none
+#include "core/common/fast_math.h"
 #include "core/common/hd.h"
 
 #include <Eigen/Core>
@@ -102,12 +103,12 @@ inline constexpr float kInvUnitScale = 1.0f / kUnitScale;
 // Branch-free on both back ends (fusion runs these for every voxel; a sign branch there is a
 // misprediction at every surface): clamp, then round half away from zero.
 RRG_HD inline int16_t encode_tsdf(float t) {  // t in [-1, 1]
-  t = fminf(fmaxf(t, -1.0f), 1.0f) * kTsdfScale;
+  t = min_f(max_f(t, -1.0f), 1.0f) * kTsdfScale;  // NaN → −1, as fminf(fmaxf(NaN, −1), 1)
   return int16_t(int(t + copysignf(0.5f, t)));
 }
 RRG_HD inline float decode_tsdf(int16_t q) { return float(q) * kInvTsdfScale; }
 RRG_HD inline uint16_t encode_unit(float c) {  // c in [0, 1]
-  return uint16_t(int(fminf(fmaxf(c, 0.0f), 1.0f) * kUnitScale + 0.5f));
+  return uint16_t(int(min_f(max_f(c, 0.0f), 1.0f) * kUnitScale + 0.5f));
 }
 RRG_HD inline float decode_unit(uint16_t q) { return float(q) * kInvUnitScale; }
 }  // namespace voxel_codec
@@ -123,7 +124,9 @@ RRG_HD inline float voxel_variance(const V& v) { return v.n > 0 ? v.m2 / float(v
 
 // Block (x, y, z) holds voxels [8x, 8x + 7] × ... ; voxel g has its centre at g · s in the world.
 RRG_HD inline bool block_in_range(int x, int y, int z) {
-  return x >= -kKeyBias && x < kKeyBias && y >= -kKeyBias && y < kKeyBias && z >= -kKeyBias && z < kKeyBias;
+  // x in [−2^20, 2^20) ⟺ x + 2^20 in [0, 2^21), as an unsigned number (negative ones wrap high).
+  constexpr uint32_t bias = kKeyBias;
+  return (((uint32_t(x) + bias) | (uint32_t(y) + bias) | (uint32_t(z) + bias)) >> kKeyBits) == 0;
 }
 RRG_HD inline uint64_t block_key(int x, int y, int z) {
   return (uint64_t(x + kKeyBias) << (2 * kKeyBits)) | (uint64_t(y + kKeyBias) << kKeyBits) |

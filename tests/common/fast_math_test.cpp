@@ -1,0 +1,58 @@
+// floor_to_int and min_f / max_f (core/common/fast_math.h) against the C library on the host.
+#include "core/common/fast_math.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+
+namespace rrg {
+namespace {
+
+TEST(FastMath, FloorToIntIsFloorOnKnownValues) {
+  EXPECT_EQ(floor_to_int(0.0f), 0);
+  EXPECT_EQ(floor_to_int(-0.0f), 0);
+  EXPECT_EQ(floor_to_int(0.999f), 0);
+  EXPECT_EQ(floor_to_int(1.0f), 1);
+  EXPECT_EQ(floor_to_int(-1e-7f), -1);
+  EXPECT_EQ(floor_to_int(-0.5f), -1);
+  EXPECT_EQ(floor_to_int(-1.0f), -1);
+  EXPECT_EQ(floor_to_int(-1.0001f), -2);
+  EXPECT_EQ(floor_to_int(16777217.0f), 16777216);  // 2^24 + 1 rounds to 2^24 as a float
+  EXPECT_EQ(floor_to_int(-3.5e8f), -350000000);
+  EXPECT_EQ(floor_to_int(2.1e9f), 2100000000);
+}
+
+// Every float bit pattern in [-2^21, 2^21) along a coarse stride, and the neighbours of every
+// integer in [-1000, 1000]: voxel and block coordinates of rooms far larger than any we map.
+TEST(FastMath, FloorToIntMatchesFloorfOverTheVoxelRange) {
+  int checked = 0;
+  for (uint32_t bits = 0; bits < 0xFFFFFFFFu - 4099; bits += 4099) {
+    float x;
+    std::memcpy(&x, &bits, sizeof x);
+    if (!(std::fabs(x) < 2097152.0f)) continue;
+    ASSERT_EQ(floor_to_int(x), int(std::floor(x))) << x;
+    ++checked;
+  }
+  for (int i = -1000; i <= 1000; ++i)
+    for (const float x : {std::nextafter(float(i), -1e9f), float(i), std::nextafter(float(i), 1e9f)}) {
+      ASSERT_EQ(floor_to_int(x), int(std::floor(x))) << x;
+      ++checked;
+    }
+  EXPECT_GT(checked, 500000);
+}
+
+TEST(FastMath, MinMaxOfNumbers) {
+  EXPECT_EQ(min_f(1.0f, 2.0f), 1.0f);
+  EXPECT_EQ(min_f(-3.0f, -2.0f), -3.0f);
+  EXPECT_EQ(max_f(1.0f, 2.0f), 2.0f);
+  EXPECT_EQ(max_f(-3.0f, -2.0f), -2.0f);
+  // NaN: the second operand, which is what the voxel codec relies on to clamp NaN into range
+  // (voxel.h: encode_tsdf(NaN) = −1 as with fminf(fmaxf(NaN, −1), 1)).
+  EXPECT_EQ(max_f(NAN, -1.0f), -1.0f);
+  EXPECT_EQ(min_f(NAN, 1.0f), 1.0f);
+}
+
+}  // namespace
+}  // namespace rrg
