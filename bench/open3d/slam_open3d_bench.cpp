@@ -27,6 +27,7 @@
 // tracking quality of both.
 #include "core/common/device.h"
 #include "core/eval/trajectory_metrics.h"
+#include "bench/open3d/bench_clock.h"
 #include "core/io/dataset.h"
 #include "core/io/trajectory.h"
 #include "core/tracking/mask_source.h"
@@ -63,17 +64,9 @@ namespace slam = open3d::t::pipelines::slam;
 
 size_t g_range_map_warnings = 0;  // Open3D's "Could not generate full range map" (see main)
 
-// Wall-clock and process CPU time (all threads; with OMP_NUM_THREADS=1 both libraries run on one
-// core, and on a shared machine the CPU time is the steadier measure of work).
-struct Clock {
-  double wall, cpu;
-};
-Clock now() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return {std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count(),
-          double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6};
-}
+using rrg::bench::Clock;
+using rrg::bench::intrinsic_tensor;
+using rrg::bench::now;
 
 // Accumulated wall and CPU milliseconds of one stage.
 struct Stage {
@@ -97,10 +90,6 @@ struct Options {
   bool o3d_half_voxel = false;                  // diagnostic, see --o3d-half-voxel
   bool open3d_only = false;                     // skip ours (diagnostic runs of Open3D's settings)
 };
-
-o3c::Tensor intrinsic_tensor(const rrg::Intrinsics& K) {
-  return o3c::Tensor::Init<double>({{K.fx, 0, K.cx}, {0, K.fy, K.cy}, {0, 0, 1}});
-}
 
 o3c::Tensor pose_tensor(const Eigen::Isometry3d& T) {  // camera -> world, as Model's T_frame_to_world
   std::vector<double> v(16);

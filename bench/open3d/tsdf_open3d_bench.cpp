@@ -6,6 +6,7 @@
 // attributes depth, vertex, normal, colour; ours: all RaycastResult maps); then mesh extraction.
 // Prints ms per frame, ratios, and how far the two raycast depth maps are apart (a sanity check
 // that both compute the same thing). Built only with -DRRG_BENCH_OPEN3D=ON when Open3D is found.
+#include "bench/open3d/bench_clock.h"
 #include "core/io/dataset.h"
 #include "core/synth/sequence.h"
 #include "core/tsdf/tsdf_integrate.h"
@@ -32,21 +33,9 @@ namespace o3c = open3d::core;
 constexpr int64_t kBlockCapacity = 40000;
 namespace o3g = open3d::t::geometry;
 
-// Wall-clock and process CPU time (all threads: on a shared machine the CPU time is the steadier
-// measure of work, and with OMP_NUM_THREADS=1 both libraries run on one core).
-struct Clock {
-  double wall, cpu;
-};
-Clock now() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return {std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count(),
-          double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6};
-}
-
-o3c::Tensor intrinsic_tensor(const rrg::Intrinsics& K) {
-  return o3c::Tensor::Init<double>({{K.fx, 0, K.cx}, {0, K.fy, K.cy}, {0, 0, 1}});
-}
+using rrg::bench::Clock;
+using rrg::bench::intrinsic_tensor;
+using rrg::bench::now;
 
 o3c::Tensor extrinsic_tensor(const Eigen::Isometry3f& T_wc) {  // Open3D wants world -> camera
   const Eigen::Matrix4d T = T_wc.inverse().matrix().cast<double>();
