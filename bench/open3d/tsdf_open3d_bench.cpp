@@ -3,7 +3,8 @@
 // voxel size, truncation (Open3D: trunc_voxel_multiplier = ε / s) and block resolution 8. Per
 // frame: integration (Open3D: GetUniqueBlockCoordinates + Integrate; ours: integrate(), which also
 // allocates); then a raycast of every frame's view (Open3D: every allocated block as the block set,
-// attributes depth, vertex, normal, colour; ours: all RaycastResult maps); then mesh extraction.
+// attributes depth, vertex, normal, colour; ours: the same maps, RaycastOutputs colour only, and
+// once more with every RaycastResult map, reported beside it); then mesh extraction.
 // Prints ms per frame, ratios, and how far the two raycast depth maps are apart (a sanity check
 // that both compute the same thing). Built only with -DRRG_BENCH_OPEN3D=ON when Open3D is found.
 #include "bench/open3d/bench_clock.h"
@@ -47,12 +48,14 @@ o3c::Tensor extrinsic_tensor(const Eigen::Isometry3f& T_wc) {  // Open3D wants w
 
 struct Times {
   Clock ours{0, 0}, open3d{0, 0};
-  void add(const Clock& t0, const Clock& t1, const Clock& t2) {
-    ours.wall += t1.wall - t0.wall;
-    ours.cpu += t1.cpu - t0.cpu;
-    open3d.wall += t2.wall - t1.wall;
-    open3d.cpu += t2.cpu - t1.cpu;
+  // Ours ran from a0 to a1, Open3D from b0 to b1.
+  void add(const Clock& a0, const Clock& a1, const Clock& b0, const Clock& b1) {
+    ours.wall += a1.wall - a0.wall;
+    ours.cpu += a1.cpu - a0.cpu;
+    open3d.wall += b1.wall - b0.wall;
+    open3d.cpu += b1.cpu - b0.cpu;
   }
+  void add(const Clock& t0, const Clock& t1, const Clock& t2) { add(t0, t1, t1, t2); }
   void print(const char* what, int n) const {
     std::printf("%-20s %9.2f %9.2f %7.2fx %9.2f %9.2f %7.2fx\n", what, ours.wall / n, open3d.wall / n,
                 open3d.wall / std::max(ours.wall, 1e-9), ours.cpu / n, open3d.cpu / n,
@@ -132,16 +135,20 @@ int main(int argc, char** argv) {
   auto hashmap = vbg.GetHashMap();
   const o3c::Tensor all_blocks = hashmap.GetKeyTensor().IndexGet({hashmap.GetActiveIndices().To(o3c::Int64)});
 
+  Times ray_all;  // ours with the reflection maps too (I, R_raw, R, C_var), against the same Open3D run
   double depth_diff = 0;
   int64_t both_hit = 0, hit_ours = 0, hit_open3d = 0;
   for (int i = 0; i < frames; ++i) {
     Clock t0 = now();
-    const rrg::RaycastResult r = rrg::raycast(ours, K, poses[size_t(i)]);
+    const rrg::RaycastResult r = rrg::raycast(ours, K, poses[size_t(i)], {}, {.color = true, .reflection = false});
     Clock t1 = now();
     auto o = vbg.RayCast(all_blocks, intr, extrinsic_tensor(poses[size_t(i)]), width, height,
                          {"depth", "vertex", "normal", "color"}, 1.0f, params.min_depth, max_depth, 1.0f, trunc_mult, 8);
     Clock t2 = now();
     ray.add(t0, t1, t2);
+    rrg::raycast(ours, K, poses[size_t(i)]);
+    Clock t3 = now();
+    ray_all.add(t2, t3, t1, t2);
     const rrg::DepthImage d = r.depth.to_host();
     const o3c::Tensor od = o.at("depth").Contiguous();
     const float* op = od.GetDataPtr<float>();
@@ -170,6 +177,7 @@ int main(int argc, char** argv) {
               "Open3D", "ratio");
   fuse.print("integrate / frame", frames);
   ray.print("raycast / frame", frames);
+  ray_all.print("  + reflection maps", frames);
   mesh.print("extract mesh", 1);
   std::printf("mesh triangles: ours %zu, Open3D %lld\n", m.triangles.size(),
               (long long)(om.HasTriangleIndices() ? om.GetTriangleIndices().GetLength() : 0));

@@ -8,14 +8,16 @@
 namespace rrg {
 
 RaycastResult raycast(const TsdfVolume& volume, const Intrinsics& K, const Eigen::Isometry3f& T_wc,
-                      std::span<const int32_t> plane_remap) {
+                      std::span<const int32_t> plane_remap, RaycastOutputs outputs) {
   if (!K.valid()) throw std::invalid_argument("raycast: invalid intrinsics " + K.to_string());
   const Device& dev = volume.device();
   const int w = K.width, h = K.height;
-  RaycastResult r{DeviceImage<float>(w, h, dev),           DeviceImage<Eigen::Vector3f>(w, h, dev),
-                  DeviceImage<Eigen::Vector3f>(w, h, dev), DeviceImage<Eigen::Vector3f>(w, h, dev),
-                  DeviceImage<int32_t>(w, h, dev),         DeviceImage<float>(w, h, dev),
-                  DeviceImage<uint8_t>(w, h, dev),         DeviceImage<float>(w, h, dev)};
+  const int wc = outputs.color ? w : 0, hc = outputs.color ? h : 0;
+  const int wr = outputs.reflection ? w : 0, hr = outputs.reflection ? h : 0;
+  RaycastResult r{DeviceImage<float>(w, h, dev),             DeviceImage<Eigen::Vector3f>(w, h, dev),
+                  DeviceImage<Eigen::Vector3f>(w, h, dev),   DeviceImage<Eigen::Vector3f>(wc, hc, dev),
+                  DeviceImage<int32_t>(wr, hr, dev),         DeviceImage<float>(wr, hr, dev),
+                  DeviceImage<uint8_t>(wr, hr, dev),         DeviceImage<float>(wr, hr, dev)};
   const auto remap = Buffer<int32_t>::from_host(plane_remap, dev);
   const TsdfParams& p = volume.params();
   const int tiles_x = (w + kernel::kRangeTile - 1) / kernel::kRangeTile;
@@ -26,7 +28,7 @@ RaycastResult raycast(const TsdfVolume& volume, const Intrinsics& K, const Eigen
                         p.min_depth, p.max_depth, {near.span(), far.span(), tiles_x, tiles_y},
                         remap.span(), r.depth.view(), r.vertices.view(), r.normals.view(), r.colors.view(),
                         r.plane_ids.view(), r.reflection.view(), r.reflection_mask.view(),
-                        r.color_variance.view()};
+                        r.color_variance.view(), outputs.color, outputs.reflection};
   RRG_DISPATCH(dev, kernel::raycast_cpu(a), kernel::raycast_cuda(a));
   return r;
 }

@@ -11,7 +11,16 @@
 
 namespace rrg {
 
-// Every image is K's size; pixels without a surface hold 0 everywhere.
+// What a raycast computes besides the geometry (D_t, V*, N*, always). Shading reads a hit's voxel
+// attributes only for the outputs asked for: tracking needs the geometry alone, the renderer all.
+struct RaycastOutputs {
+  bool color = true;       // C_t
+  bool reflection = true;  // I, R_raw, R, C_var
+  static constexpr RaycastOutputs all() { return {true, true}; }
+  static constexpr RaycastOutputs geometry() { return {false, false}; }
+};
+
+// Every image asked for is K's size (the others are empty, 0 x 0); pixels without a surface hold 0.
 struct RaycastResult {
   DeviceImage<float> depth;                // D_t: depth along the optical axis, metres
   DeviceImage<Eigen::Vector3f> vertices;   // V*: world frame
@@ -28,6 +37,6 @@ struct RaycastResult {
 // resident on the device are seen: blocks streamed out (TsdfVolume::stream_out) must be brought
 // back with stream_in first. Range image, empty-space skipping and refinement: docs/tsdf.md.
 RaycastResult raycast(const TsdfVolume& volume, const Intrinsics& K, const Eigen::Isometry3f& T_wc,
-                      std::span<const int32_t> plane_remap = {});
+                      std::span<const int32_t> plane_remap = {}, RaycastOutputs outputs = RaycastOutputs::all());
 
 }  // namespace rrg

@@ -45,19 +45,17 @@ RRG_HD inline RayHit march(const VolumeView& vol, const Eigen::Vector3f& o, cons
                            float truncation, float z_start, float z_end, BlockCache& cache) {
   RayHit hit;
   const float len = d.norm();           // metres per unit of z
-  const float s = vol.voxel_size, inv_s = 1.0f / s;
+  const float s = vol.voxel_size;
   const Eigen::Vector3f inv_d(1.0f / d.x(), 1.0f / d.y(), 1.0f / d.z());
   const float voxel_z = s / len, nudge_z = 1e-3f * s / len;  // one voxel, 1/1000 voxel along the ray
   float z = z_start, z_prev = 0.0f, f_prev = 0.0f;
   bool have_prev = false;
   while (z < z_end) {
     const Eigen::Vector3f p = o + z * d;
-    float f = 0.0f;
-    const Sample sample = sample_tsdf_at(vol, p, cache, f);
+    Corners corners;
+    const Sample sample = trilinear_corners(vol, p, cache, corners);
     if (sample == Sample::NoBlock) {  // empty space: skip the whole block
-      const Eigen::Vector3f q = p * inv_s;
-      const Eigen::Vector3i b(block_of(floor_to_int(q.x())), block_of(floor_to_int(q.y())), block_of(floor_to_int(q.z())));
-      z += block_exit(p, d, inv_d, b, s) + nudge_z;
+      z += block_exit(p, d, inv_d, corners.block, s) + nudge_z;
       have_prev = false;
       continue;
     }
@@ -66,6 +64,7 @@ RRG_HD inline RayHit march(const VolumeView& vol, const Eigen::Vector3f& o, cons
       have_prev = false;
       continue;
     }
+    const float f = trilinear(corners.t, corners.f) * voxel_codec::kInvTsdfScale;
     if (have_prev && f_prev > 0.0f && f <= 0.0f) {
       // Regula falsi with the Illinois modification on the bracket [z_prev, z]: the trilinear TSDF
       // is cubic along the ray, so plain secant steps can stall on one side of a large bracket.
@@ -129,10 +128,11 @@ struct Neighbourhood {
   }
 };
 
-// Attributes at a surface point p (trilinear, as the supplement's C_var). `cache` may hold blocks
-// from the march.
+// Normal and attributes at a surface point p (trilinear, as the supplement's C_var); the colour
+// and the reflection attributes (π, R_raw, C_var) only when asked for (left 0 otherwise). `cache`
+// may hold blocks from the march.
 RRG_HD inline SurfaceSample shade(const VolumeView& vol, const Eigen::Vector3f& p, Span<const int32_t> remap,
-                                  BlockCache& cache) {
+                                  BlockCache& cache, bool want_color, bool want_reflection) {
   constexpr float kEps = 1e-6f;
   SurfaceSample out;
   const Eigen::Vector3f q = p * (1.0f / vol.voxel_size);
@@ -181,21 +181,24 @@ RRG_HD inline SurfaceSample shade(const VolumeView& vol, const Eigen::Vector3f& 
   }
   float w[8];
   for (int c = 0; c < 8; ++c) w[c] = corner_weight(f, c);
-  float w_refl = 0.0f;
-  for (int i = 0; i < 8; ++i) {
-    const AttrVoxel& a = vol.attributes[corner[i]];
-    out.color += w[i] * voxel_color(a);
-    if (a.n > 0) {
-      out.variance += w[i] * voxel_variance(a);
-      out.reflection += w[i] * voxel_codec::decode_unit(a.r);
-      w_refl += w[i];
+  if (want_color)
+    for (int i = 0; i < 8; ++i) out.color += w[i] * voxel_color(vol.attributes[corner[i]]);
+  if (want_reflection) {
+    float w_refl = 0.0f;
+    for (int i = 0; i < 8; ++i) {
+      const AttrVoxel& a = vol.attributes[corner[i]];
+      if (a.n > 0) {
+        out.variance += w[i] * voxel_variance(a);
+        out.reflection += w[i] * voxel_codec::decode_unit(a.r);
+        w_refl += w[i];
+      }
     }
+    out.variance /= (w_refl + kEps);
+    out.reflection /= (w_refl + kEps);
+    // π of the nearest voxel (a corner of the cell), canonical through the remap table.
+    const int nearest = (f.x() >= 0.5f ? 1 : 0) | (f.y() >= 0.5f ? 2 : 0) | (f.z() >= 0.5f ? 4 : 0);
+    out.plane = canonical_plane(remap, int32_t(vol.attributes[corner[nearest]].plane));
   }
-  out.variance /= (w_refl + kEps);
-  out.reflection /= (w_refl + kEps);
-  // π of the nearest voxel (a corner of the cell), canonical through the remap table.
-  const int nearest = (f.x() >= 0.5f ? 1 : 0) | (f.y() >= 0.5f ? 2 : 0) | (f.z() >= 0.5f ? 4 : 0);
-  out.plane = canonical_plane(remap, int32_t(vol.attributes[corner[nearest]].plane));
   // Normal: central differences of the trilinear TSDF one voxel apart,
   //   f(p + s e_k) − f(p − s e_k) = Σ_c w_c (d(c + e_k) − d(c − e_k)),
   // when all 24 voxels beyond the cell are observed; within the cell otherwise.

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace rrg {
@@ -121,6 +122,51 @@ TEST(TsdfRaycast, FastMarchAgreesFromFarAndFromInside) {
     const Comparison c = compare_with_reference(volume, kSmallK, T);
     EXPECT_EQ(c.hit_mismatch, 0);
     EXPECT_LT(c.worst_depth, 0.05f * volume.params().voxel_size);
+  }
+}
+
+// RaycastOutputs: leaving out the colour or the reflection maps changes nothing in the maps that are
+// computed, and the maps left out are empty.
+void expect_outputs_independent(const Device& device) {
+  const test::Scene scene = test::sphere_scene({0, 0, 0}, 0.3f);
+  TsdfVolume volume(params_1cm(), device);
+  test::fuse_scene(volume, scene, kSmallK, test::cameras_around({0, 0, 0}, 1.0f));
+  const Eigen::Isometry3f T = test::look_at({0.3f, 0.2f, -1.2f}, {0, 0, 0});
+  const RaycastResult all = raycast(volume, kSmallK, T);
+  const RaycastResult geometry = raycast(volume, kSmallK, T, {}, RaycastOutputs::geometry());
+  const RaycastResult color = raycast(volume, kSmallK, T, {}, {.color = true, .reflection = false});
+  const RaycastResult refl = raycast(volume, kSmallK, T, {}, {.color = false, .reflection = true});
+  const auto same = [](const auto& a, const auto& b) {
+    const auto ha = a.to_host(), hb = b.to_host();
+    return ha.same_size(hb) && std::equal(ha.data(), ha.data() + ha.size(), hb.data());
+  };
+  const DepthImage depth = all.depth.to_host();
+  EXPECT_GT(std::count_if(depth.data(), depth.data() + depth.size(), [](float d) { return d > 0; }), 1000);
+  for (const RaycastResult* r : {&geometry, &color, &refl}) {
+    EXPECT_TRUE(same(r->depth, all.depth));
+    EXPECT_TRUE(same(r->vertices, all.vertices));
+    EXPECT_TRUE(same(r->normals, all.normals));
+  }
+  EXPECT_TRUE(same(color.colors, all.colors));
+  EXPECT_TRUE(same(refl.color_variance, all.color_variance));
+  EXPECT_TRUE(same(refl.plane_ids, all.plane_ids));
+  EXPECT_TRUE(same(refl.reflection, all.reflection));
+  EXPECT_TRUE(same(refl.reflection_mask, all.reflection_mask));
+  EXPECT_EQ(all.colors.width(), kSmallK.width);
+  for (const RaycastResult* r : {&geometry, &refl}) EXPECT_EQ(r->colors.width() * r->colors.height(), 0);
+  for (const RaycastResult* r : {&geometry, &color}) {
+    EXPECT_EQ(r->color_variance.width() * r->color_variance.height(), 0);
+    EXPECT_EQ(r->plane_ids.width() * r->plane_ids.height(), 0);
+    EXPECT_EQ(r->reflection.width() * r->reflection.height(), 0);
+    EXPECT_EQ(r->reflection_mask.width() * r->reflection_mask.height(), 0);
+  }
+}
+
+// On every device (the kernel branches on the flags).
+TEST(TsdfRaycast, OutputsLeftOutAreEmptyAndTheOthersUnchanged) {
+  for (const Device& device : available_devices()) {
+    SCOPED_TRACE(device.to_string());
+    expect_outputs_independent(device);
   }
 }
 
