@@ -9,6 +9,8 @@
 #include <unordered_set>
 #include <vector>
 
+#include <spdlog/spdlog.h>
+
 namespace rrg {
 
 namespace {
@@ -188,16 +190,24 @@ GaussianHost densify_reflection(const DensifyView& v, std::span<const Reflective
   const int S = p.reflection_samples;
   const bool mirrored = p.reflection_mirrored_depth && v.virtual_depth != nullptr;
   if (mirrored) check_image(v.virtual_depth, v.K, "virtual_depth");
+  // Pixels left after each test, in order (the debug log shows where candidates are lost).
+  int64_t on_plane = 0, masked = 0, wrong = 0, varying = 0, uncovered = 0, sampled = 0;
   for (int y = 0; y < v.K.height; ++y)
     for (int x = 0; x < v.K.width; ++x) {
       const int32_t id = (*v.I)(x, y);
-      if (id <= 0 || (*v.R)(x, y) == 0) continue;
-      const auto it = by_id.find(id);
+      const auto it = id > 0 ? by_id.find(id) : by_id.end();
       if (it == by_id.end()) continue;
-      if (!(color_error((*v.C_gt)(x, y), (*v.C)(x, y)) > p.reflection_error && (*v.C_var)(x, y) > p.variance &&
-            (*v.W_r)(x, y) < p.reflection_weight))
-        continue;
+      ++on_plane;
+      if ((*v.R)(x, y) == 0) continue;
+      ++masked;
+      if (!(color_error((*v.C_gt)(x, y), (*v.C)(x, y)) > p.reflection_error)) continue;
+      ++wrong;
+      if (!((*v.C_var)(x, y) > p.variance)) continue;
+      ++varying;
+      if (!((*v.W_r)(x, y) < p.reflection_weight)) continue;
+      ++uncovered;
       if (!(pixel_uniform(seed, int64_t(y) * v.K.width + x) < p.sample_ratio)) continue;
+      ++sampled;
       const Eigen::Vector3f dir = (R_wc * v.K.unproject(float(x), float(y), 1.0f)).normalized();
       const Eigen::Vector3f n = it->second.head<3>();
       const float denom = n.dot(dir);
@@ -230,6 +240,10 @@ GaussianHost densify_reflection(const DensifyView& v, std::span<const Reflective
         ids.push_back(id);
       }
     }
+  spdlog::debug("densify_reflection: {} reflective plane(s); pixels on them {}, with R = 1 {}, error > {} {}, "
+                "C_var > {} {}, W_r < {} {}, sampled {}",
+                planes.size(), on_plane, masked, p.reflection_error, wrong, p.variance, varying, p.reflection_weight,
+                uncovered, sampled);
   return init_gaussians(pts, nrm, col, ids, p, p.reflection_min_init_scale, p.reflection_max_init_scale, sh_degree);
 }
 
