@@ -35,7 +35,8 @@ struct RaycastResult {
 // Casts a ray through every pixel of a camera (K, T_wc) within [min_depth, max_depth] of the
 // volume's params; plane ids go through plane_remap (id -> canonical id) as in fusion. Only blocks
 // resident on the device are seen: blocks streamed out (TsdfVolume::stream_out) must be brought
-// back with stream_in first. Range image, empty-space skipping and refinement: docs/tsdf.md.
+// back with stream_in first. `outputs` picks the maps beyond the geometry (all by default). Range
+// image, empty-space skipping and refinement: docs/tsdf.md.
 RaycastResult raycast(const TsdfVolume& volume, const Intrinsics& K, const Eigen::Isometry3f& T_wc,
                       std::span<const int32_t> plane_remap = {}, RaycastOutputs outputs = RaycastOutputs::all());
 
