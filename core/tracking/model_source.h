@@ -17,15 +17,14 @@ class ModelSource {
   virtual IcpModel model_at(const Eigen::Isometry3f& T_wc) = 0;
 };
 
-// Raycasts a TSDF volume (V*, N* in the world frame) with intrinsics K; the last raycast is kept
-// and reused when asked again for the same pose.
+// Raycasts a TSDF volume (V*, N* in the world frame; the geometry only, RaycastOutputs) with
+// intrinsics K; the last raycast is kept and reused when asked again for the same pose.
 class TsdfModelSource final : public ModelSource {
  public:
   TsdfModelSource(const TsdfVolume& volume, const Intrinsics& K) : volume_(volume), K_(K) {}
   IcpModel model_at(const Eigen::Isometry3f& T_wc) override;
   // Forgets the cached raycast (call after fusing a frame).
   void invalidate() { cached_.reset(); }
-  const RaycastResult* last() const { return cached_ ? &*cached_ : nullptr; }
 
  private:
   const TsdfVolume& volume_;

@@ -1,6 +1,6 @@
 #pragma once
-// Reading the volume at world points: voxel lookup through the hash (with a one-block cache) and
-// trilinear interpolation over the 8 voxels around a point. Shared by raycasting and tests.
+// Reading the volume at world points: block lookup through the hash (with a small per-ray block
+// cache) and trilinear interpolation over the 8 voxels around a point. Shared by raycasting and tests.
 #include "core/common/fast_math.h"
 #include "core/tsdf/voxel_hash_device.h"
 
