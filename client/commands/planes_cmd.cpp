@@ -182,7 +182,7 @@ void register_planes_command(CLI::App& app) {
   io::add_dataset_flags(*s, seg->flags);
   s->add_option("--every", seg->every, "segment every N-th frame")->capture_default_str();
   s->add_option("--frames", seg->max_frames, "at most this many frames (0 = all)")->capture_default_str();
-  s->add_option("--cell", seg->cell, "cell size in pixels (0 = width / 48)")->capture_default_str();
+  s->add_option("--cell", seg->cell, "cell size in pixels (0 = width / 40)")->capture_default_str();
   s->add_option("--out", seg->out, "write local plane maps (16-bit PNG, 0 = none) to this folder");
   s->add_flag("--json", seg->json, "print JSON instead of a table");
   s->callback([seg] { run_segment(*seg); });

@@ -39,7 +39,7 @@ bool has_depth_jump(const Image<Eigen::Vector3f>& points, int x0, int y0, int x1
 
 CellGrid fit_cells(const Image<Eigen::Vector3f>& points, const PlaneSegmentationParams& params) {
   CellGrid g;
-  g.size = params.cell_size > 0 ? params.cell_size : std::max(4, points.width() / 48);
+  g.size = params.cell_size > 0 ? params.cell_size : std::max(4, points.width() / 40);
   g.nx = (points.width() + g.size - 1) / g.size;
   g.ny = (points.height() + g.size - 1) / g.size;
   const size_t n = size_t(g.nx) * size_t(g.ny);
@@ -62,8 +62,7 @@ CellGrid fit_cells(const Image<Eigen::Vector3f>& points, const PlaneSegmentation
     g.fits[size_t(c)] = fit;
     g.depth[size_t(c)] = fit.centroid.z();
     if (!fit.valid) continue;
-    const float sigma = params.sigma(fit.centroid.z());
-    if (std::sqrt(fit.mse) > sigma) continue;
+    if (std::sqrt(fit.mse) > params.planar_rms(fit.centroid.z())) continue;
     if (has_depth_jump(points, x0, y0, x1, y1, params.jump_ratio)) continue;
     g.planar[size_t(c)] = 1;
   }

@@ -23,6 +23,7 @@ void PlaneSegmentationParams::validate() const {
   need(cell_size == 0 || cell_size >= 3, "cell_size must be 0 (auto) or >= 3");
   need(min_valid_ratio > 0 && min_valid_ratio <= 1, "min_valid_ratio must be in (0, 1]");
   need(sigma_min > 0 && sigma_k >= 0, "sigma_min must be > 0 and sigma_k >= 0");
+  need(noise_a >= 0 && noise_b >= 0 && planar_sigmas > 0, "noise_a, noise_b must be >= 0 and planar_sigmas > 0");
   need(jump_ratio > 0, "jump_ratio must be > 0");
   need(histogram_bins >= 1, "histogram_bins must be >= 1");
   need(grow_angle_deg > 0 && grow_angle_deg < 90, "grow_angle_deg must be in (0, 90)");
@@ -34,9 +35,11 @@ void PlaneSegmentationParams::validate() const {
 }
 
 std::string PlaneSegmentationParams::to_string() const {
-  return fmt::format("cell {} px, sigma max({} m, {} z^2), grow {} deg / {} sigma, merge {} deg / {} m, "
+  return fmt::format("cell {} px, noise {} + {} (z - {})^2 m, planar {} noise sigma, "
+                     "sigma max({} m, {} z^2), grow {} deg / {} sigma, merge {} deg / {} m, "
                      "refine {} sigma, min region {} cells",
-                     cell_size, sigma_min, sigma_k, grow_angle_deg, grow_distance_sigmas, merge_angle_deg,
+                     cell_size, noise_a, noise_b, noise_z0, planar_sigmas, sigma_min, sigma_k,
+                     grow_angle_deg, grow_distance_sigmas, merge_angle_deg,
                      merge_distance, refine_distance_sigmas, min_region_cells);
 }
 
@@ -83,7 +86,11 @@ int grow_regions(const CellGrid& g, const PlaneSegmentationParams& p, std::vecto
     size_t& at = cursor[size_t(bin)];
     while (used[size_t(cells[at])]) ++at;
     const int seed = cells[at];
-    const Plane& sp = g.fits[size_t(seed)].plane;
+    // Neighbours are compared with the region's plane, refitted to the pooled moments of its cells
+    // each time the region doubles: a lone cell's normal scatters by degrees under sensor noise.
+    Plane sp = g.fits[size_t(seed)].plane;
+    PlaneMoments pooled;
+    size_t refit_at = 2;
     members.clear();
     queue.assign(1, seed);
     used[size_t(seed)] = 1;
@@ -91,6 +98,12 @@ int grow_regions(const CellGrid& g, const PlaneSegmentationParams& p, std::vecto
       const int c = queue.front();
       queue.pop_front();
       members.push_back(c);
+      pooled.merge(g.moments[size_t(c)]);
+      if (members.size() == refit_at) {
+        const PlaneFit f = fit_plane(pooled);
+        if (f.valid) sp = f.plane;
+        refit_at *= 2;
+      }
       --count[size_t(bin_of[size_t(c)])];
       const int cx = c % g.nx, cy = c / g.nx;
       const int nbs[4][2] = {{cx - 1, cy}, {cx + 1, cy}, {cx, cy - 1}, {cx, cy + 1}};
@@ -203,8 +216,7 @@ Image<int> refine_pixels(const CellGrid& g, const Image<Eigen::Vector3f>& points
       for (int u = x0; u < x1; ++u) {
         const Eigen::Vector3f& pt = points(u, v);
         if (pt.z() <= 0.0f) continue;
-        const float tol = std::max(p.min_refine_distance, p.refine_distance_sigmas * p.sigma(pt.z()));
-        float best = tol;
+        float best = p.refine_distance(pt.z());
         for (int r : list) {
           const float d = std::abs(fits[size_t(r)].plane.signed_distance(pt));
           if (d < best) {
@@ -229,7 +241,51 @@ PlaneSegmentation segment_planes(const DepthImage& depth, const Intrinsics& K, c
   std::vector<int> region;
   const int grown = grow_regions(grid, params, region);
   const std::vector<PlaneFit> fits = merge_regions(grid, params, grown, region);
-  const Image<int> label = refine_pixels(grid, points, params, region, fits);
+  Image<int> label = refine_pixels(grid, points, params, region, fits);
+  // A sliver between real planes: cells across a floor-wall crease pass the planarity test under
+  // sensor noise, and their in-between plane wins the pixels near the crease. It keeps under half
+  // of its own cells' pixels, and nearly every pixel it wins lies within the refinement distance of
+  // another region's plane as well. Such regions are dropped and the pixels refined again (a thin
+  // real plane, such as a frame standing out of a wall, wins pixels no other plane explains).
+  std::vector<int64_t> own(fits.size(), 0), kept(fits.size(), 0), won(fits.size(), 0), shared(fits.size(), 0);
+  for (int c = 0; c < int(region.size()); ++c) {
+    const int r = region[size_t(c)];
+    if (r < 0) continue;
+    const int x0 = grid.x0(c % grid.nx), y0 = grid.y0(c / grid.nx);
+    for (int v = y0; v < std::min(y0 + grid.size, points.height()); ++v)
+      for (int u = x0; u < std::min(x0 + grid.size, points.width()); ++u) {
+        const Eigen::Vector3f& pt = points(u, v);
+        if (pt.z() <= 0.0f) continue;
+        ++own[size_t(r)];
+        kept[size_t(r)] += label(u, v) == r ? 1 : 0;
+      }
+  }
+  for (int v = 0; v < points.height(); ++v)
+    for (int u = 0; u < points.width(); ++u) {
+      const int l = label(u, v);
+      if (l < 0) continue;
+      ++won[size_t(l)];
+      const Eigen::Vector3f& pt = points(u, v);
+      const float tol = params.refine_distance(pt.z());
+      // the regions of this pixel's cell and its 8 neighbours: the candidates refinement used
+      const int cx = u / grid.size, cy = v / grid.size;
+      bool other = false;
+      for (int dy = -1; dy <= 1 && !other; ++dy)
+        for (int dx = -1; dx <= 1 && !other; ++dx) {
+          const int x = cx + dx, y = cy + dy;
+          if (x < 0 || y < 0 || x >= grid.nx || y >= grid.ny) continue;
+          const int r = region[size_t(grid.index(x, y))];
+          other = r >= 0 && r != l && std::abs(fits[size_t(r)].plane.signed_distance(pt)) < tol;
+        }
+      shared[size_t(l)] += other ? 1 : 0;
+    }
+  bool slivers = false;
+  std::vector<uint8_t> sliver(fits.size(), 0);
+  for (size_t r = 0; r < fits.size(); ++r)
+    sliver[r] = 2 * kept[r] < own[r] && 10 * shared[r] >= 9 * won[r];
+  for (int& r : region)
+    if (r >= 0 && sliver[size_t(r)]) r = -1, slivers = true;
+  if (slivers) label = refine_pixels(grid, points, params, region, fits);
 
   // Refit every plane to its pixels; drop the small ones; order by size.
   std::vector<PlaneMoments> moments(fits.size());

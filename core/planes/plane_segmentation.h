@@ -1,8 +1,8 @@
 #pragma once
 // CAPE-class depth plane segmentation (Proença & Gao 2018, paper §4.1.3), CPU only like CAPE:
 //  1. cell-wise PCA plane fits on a regular grid of the organised point cloud, with a planarity
-//     test (valid depth, no depth jump along the cell's middle row/column, RMS below the depth
-//     noise model σ(z) = max(σ_min, k_σ z²));
+//     test (valid depth, no depth jump along the cell's middle row/column, fit RMS within the
+//     sensor's noise);
 //  2. region growing seeded from the most populated bin of a histogram of cell normals (polar,
 //     azimuth), comparing neighbour cells with the seed's plane;
 //  3. merging of adjacent regions whose planes agree (normal angle and centroid distances);
@@ -18,12 +18,16 @@
 namespace rrg {
 
 struct PlaneSegmentationParams {
-  int cell_size = 0;                 // cell side in pixels; 0 = width / 48 (13 px at 640x480; CAPE uses
+  int cell_size = 0;                 // cell side in pixels; 0 = width / 40 (16 px at 640x480; CAPE uses
                                      // 20 for Kinect noise; smaller cells keep 8 cm strips at 3 m)
   float min_valid_ratio = 0.5f;      // a cell needs this fraction of pixels with depth
-  float sigma_min = 0.002f;          // σ_min, metres: planarity RMS floor
-  float sigma_k = 0.001f;            // k_σ, 1/m: σ(z) = max(σ_min, k_σ z²) (depth noise growing with z²;
-                                     // raise both for Kinect-class sensors, e.g. 0.004 / 0.0025)
+  // Sensor axial noise σ_n(z) = a + b (z − z0)², metres: Kinect v1 (Nguyen, Izadi & Lovell 2012),
+  // the class of RGB-D sensors the paper and CAPE target. It bounds the cell fit (RMS < planar_sigmas
+  // σ_n, or σ(z) below when larger) and widens the pixel refinement to refine_distance_sigmas σ_n.
+  float noise_a = 0.0012f, noise_b = 0.0019f, noise_z0 = 0.4f;
+  float planar_sigmas = 2.0f;
+  float sigma_min = 0.002f;          // σ_min, metres: floor of the distance scale σ(z) below
+  float sigma_k = 0.001f;            // k_σ, 1/m: σ(z) = max(σ_min, k_σ z²): growing and merging distances
   float jump_ratio = 0.03f;          // depth jump between neighbours along a cell's middle lines > ratio·z: not planar
   int histogram_bins = 20;           // bins per axis of the normal histogram (polar, azimuth)
   float grow_angle_deg = 12.0f;      // neighbour normal vs seed normal during growing
@@ -32,13 +36,18 @@ struct PlaneSegmentationParams {
   int min_region_cells = 4;          // smaller regions are dropped
   float merge_angle_deg = 10.0f;     // adjacent regions merge when normals agree within this
   float merge_distance = 0.01f;      // ... and each centroid lies within max(this, 3 σ(z)) of the other plane
-  float refine_distance_sigmas = 2.5f;  // pixel-level assignment: |n·p + b| < max(min_refine, this·σ(z))
+  float refine_distance_sigmas = 2.5f;  // pixel-level assignment: |n·p + b| < max(min_refine, this·max(σ, σ_n))
   float min_refine_distance = 0.01f;
   int min_plane_pixels = 0;          // after refinement; 0 = 2 cells' worth of pixels
 
   void validate() const;             // throws std::invalid_argument naming the bad field
   std::string to_string() const;
   float sigma(float z) const { return std::max(sigma_min, sigma_k * z * z); }
+  float noise_sigma(float z) const { return noise_a + noise_b * (z - noise_z0) * (z - noise_z0); }
+  float planar_rms(float z) const { return std::max(sigma(z), planar_sigmas * noise_sigma(z)); }
+  float refine_distance(float z) const {
+    return std::max(min_refine_distance, refine_distance_sigmas * std::max(sigma(z), noise_sigma(z)));
+  }
 };
 
 // Segments a depth map (metres, 0 = invalid) of a camera with intrinsics K (same size; throws
