@@ -39,7 +39,10 @@ RRG_HD inline float block_exit(const Eigen::Vector3f& p, const Eigen::Vector3f& 
 // (shade() of the hit reuses them). Steps:
 //   block of floor(p / s) not allocated       → to the ray's exit from that block (DDA over blocks);
 //   sample invalid (a corner unobserved)      → one voxel;
-//   f = d/ε > 0                               → max(s, 0.8 · f · ε) (the TSDF is a distance bound);
+//   f = d/ε > 0                               → max(s, f · ε): the TSDF is the distance to the surface
+//                                                along the fusing rays, so a step may overshoot it only
+//                                                into the band behind it (f ≥ −1), where the crossing
+//                                                is still bracketed (as Open3D's march steps);
 //   f ≤ 0 without a positive sample before    → one voxel (entering from behind a surface).
 RRG_HD inline RayHit march(const VolumeView& vol, const Eigen::Vector3f& o, const Eigen::Vector3f& d,
                            float truncation, float z_start, float z_end, BlockCache& cache) {
@@ -97,7 +100,7 @@ RRG_HD inline RayHit march(const VolumeView& vol, const Eigen::Vector3f& o, cons
     have_prev = true;
     z_prev = z;
     f_prev = f;
-    z += f > 0.0f ? max_f(voxel_z, 0.8f * f * truncation / len) : voxel_z;
+    z += f > 0.0f ? max_f(voxel_z, f * truncation / len) : voxel_z;
   }
   return hit;
 }
