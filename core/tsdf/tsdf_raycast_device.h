@@ -38,7 +38,8 @@ RRG_HD inline float block_exit(const Eigen::Vector3f& p, const Eigen::Vector3f& 
 // the sample's own distance |d| is below kRefineTol voxels. `cache` holds the blocks looked up
 // (shade() of the hit reuses them). Steps:
 //   block of floor(p / s) not allocated       → to the ray's exit from that block (DDA over blocks);
-//   sample invalid (a corner unobserved)      → one voxel;
+//   sample invalid (a corner unobserved)      → one voxel; when no corner is observed, to the exit of
+//                                                the box of cells sharing a corner with this one;
 //   f = d/ε > 0                               → max(s, f · ε): the TSDF is the distance to the surface
 //                                                along the fusing rays, so a step may overshoot it only
 //                                                into the band behind it (f ≥ −1), where the crossing
@@ -63,7 +64,16 @@ RRG_HD inline RayHit march(const VolumeView& vol, const Eigen::Vector3f& o, cons
       continue;
     }
     if (sample == Sample::Unobserved) {
-      z += voxel_z;
+      // No corner of the cell observed: every cell sharing one of its corners is invalid too, so
+      // no valid sample lies in the box g − 1 .. g + 2 (voxel units) around it; skip to its exit,
+      // which is at least one voxel away. Otherwise one voxel.
+      float step = voxel_z;
+      if (corners.missing == 8) {
+        step = 1e30f;
+        for (int k = 0; k < 3; ++k)
+          if (d[k] != 0.0f) step = min_f(step, (d[k] > 0.0f ? 2.0f - corners.f[k] : 1.0f + corners.f[k]) * s * fabsf(inv_d[k]));
+      }
+      z += step;
       have_prev = false;
       continue;
     }

@@ -57,6 +57,7 @@ struct Corners {
   float t[8];
   Eigen::Vector3f f;
   Eigen::Vector3i block;
+  int missing = 0;  // corners unobserved (weight 0); 8 means none of the cell's voxels is observed
 };
 
 RRG_HD RRG_INLINE Sample trilinear_corners(const VolumeView& vol, const Eigen::Vector3f& p_w, BlockCache& cache,
@@ -75,17 +76,18 @@ RRG_HD RRG_INLINE Sample trilinear_corners(const VolumeView& vol, const Eigen::V
   // Axes along which the cell leaves the block (local coordinate 7): bit 0 x, 1 y, 2 z. One branch
   // on all three (the cell is in one block in (7/8)³ of the cases).
   const int crossing = ((lx + 1) >> 3) | (((ly + 1) >> 3) << 1) | (((lz + 1) >> 3) << 2);  // l + 1 = 8 ⟺ l = 7
-  int unobserved = 0;
+  int missing = 0;
   if (crossing == 0) {
     // The whole cell in one block: fixed offsets from the lower corner.
     RRG_UNROLL
     for (int c = 0; c < 8; ++c) {
       const int64_t v = v0 + local_index(c & 1, (c >> 1) & 1, c >> 2);
       const TsdfVoxel g = vol.geometry[v];
-      unobserved |= int(g.weight == 0);
+      missing += int(g.weight == 0);
       out.t[c] = float(g.tsdf);
     }
-    return unobserved ? Sample::Unobserved : Sample::Valid;
+    out.missing = missing;
+    return missing ? Sample::Unobserved : Sample::Valid;
   }
   // The cell straddles blocks: where a local coordinate is 7, the corners one further lie in the
   // +x / +y / +z neighbour; each of those blocks is looked up once, through the cache.
@@ -103,10 +105,11 @@ RRG_HD RRG_INLINE Sample trilinear_corners(const VolumeView& vol, const Eigen::V
     const int o = (x >> 3) | ((y >> 3) << 1) | ((z >> 3) << 2);
     const int64_t v = first[o] + local_index(x & 7, y & 7, z & 7);
     const TsdfVoxel g = vol.geometry[v];
-    unobserved |= int(g.weight == 0);
+    missing += int(g.weight == 0);
     out.t[c] = float(g.tsdf);
   }
-  return unobserved ? Sample::Unobserved : Sample::Valid;
+  out.missing = missing;
+  return missing ? Sample::Unobserved : Sample::Valid;
 }
 
 // Trilinear weight of corner c at f.
