@@ -229,6 +229,53 @@ Image<int> refine_pixels(const CellGrid& g, const Image<Eigen::Vector3f>& points
   return label;
 }
 
+// Step 4b: a sliver between real planes. Cells across a floor-wall crease pass the planarity test
+// under sensor noise, and their in-between plane wins the pixels near the crease. Such a region
+// keeps under half of its own cells' pixels, and nearly every pixel it wins (≥ 90 %) lies within the
+// refinement distance of another candidate region's plane as well; a thin real plane, such as a
+// frame standing out of a wall, wins pixels no other plane explains. Slivers leave `region` (set to
+// -1); returns whether any did, so that the pixels are refined again without them.
+bool drop_slivers(const CellGrid& g, const Image<Eigen::Vector3f>& points, const PlaneSegmentationParams& p,
+                  const Image<int>& label, const std::vector<PlaneFit>& fits, std::vector<int>& region) {
+  std::vector<int64_t> own(fits.size(), 0), kept(fits.size(), 0), won(fits.size(), 0), shared(fits.size(), 0);
+  for (int c = 0; c < int(region.size()); ++c) {
+    const int r = region[size_t(c)];
+    if (r < 0) continue;
+    const int x0 = g.x0(c % g.nx), y0 = g.y0(c / g.nx);
+    for (int v = y0; v < std::min(y0 + g.size, points.height()); ++v)
+      for (int u = x0; u < std::min(x0 + g.size, points.width()); ++u) {
+        if (points(u, v).z() <= 0.0f) continue;
+        ++own[size_t(r)];
+        kept[size_t(r)] += label(u, v) == r ? 1 : 0;
+      }
+  }
+  for (int v = 0; v < points.height(); ++v)
+    for (int u = 0; u < points.width(); ++u) {
+      const int l = label(u, v);
+      if (l < 0) continue;
+      ++won[size_t(l)];
+      const Eigen::Vector3f& pt = points(u, v);
+      const float tol = p.refine_distance(pt.z());
+      const int cx = u / g.size, cy = v / g.size;  // candidates: the regions of this cell and its ring
+      bool other = false;
+      for (int dy = -1; dy <= 1 && !other; ++dy)
+        for (int dx = -1; dx <= 1 && !other; ++dx) {
+          const int x = cx + dx, y = cy + dy;
+          if (x < 0 || y < 0 || x >= g.nx || y >= g.ny) continue;
+          const int r = region[size_t(g.index(x, y))];
+          other = r >= 0 && r != l && std::abs(fits[size_t(r)].plane.signed_distance(pt)) < tol;
+        }
+      shared[size_t(l)] += other ? 1 : 0;
+    }
+  bool any = false;
+  for (int& r : region)
+    if (r >= 0 && 2 * kept[size_t(r)] < own[size_t(r)] && 10 * shared[size_t(r)] >= 9 * won[size_t(r)]) {
+      r = -1;
+      any = true;
+    }
+  return any;
+}
+
 }  // namespace
 
 PlaneSegmentation segment_planes(const DepthImage& depth, const Intrinsics& K, const PlaneSegmentationParams& params) {
@@ -242,50 +289,8 @@ PlaneSegmentation segment_planes(const DepthImage& depth, const Intrinsics& K, c
   const int grown = grow_regions(grid, params, region);
   const std::vector<PlaneFit> fits = merge_regions(grid, params, grown, region);
   Image<int> label = refine_pixels(grid, points, params, region, fits);
-  // A sliver between real planes: cells across a floor-wall crease pass the planarity test under
-  // sensor noise, and their in-between plane wins the pixels near the crease. It keeps under half
-  // of its own cells' pixels, and nearly every pixel it wins lies within the refinement distance of
-  // another region's plane as well. Such regions are dropped and the pixels refined again (a thin
-  // real plane, such as a frame standing out of a wall, wins pixels no other plane explains).
-  std::vector<int64_t> own(fits.size(), 0), kept(fits.size(), 0), won(fits.size(), 0), shared(fits.size(), 0);
-  for (int c = 0; c < int(region.size()); ++c) {
-    const int r = region[size_t(c)];
-    if (r < 0) continue;
-    const int x0 = grid.x0(c % grid.nx), y0 = grid.y0(c / grid.nx);
-    for (int v = y0; v < std::min(y0 + grid.size, points.height()); ++v)
-      for (int u = x0; u < std::min(x0 + grid.size, points.width()); ++u) {
-        const Eigen::Vector3f& pt = points(u, v);
-        if (pt.z() <= 0.0f) continue;
-        ++own[size_t(r)];
-        kept[size_t(r)] += label(u, v) == r ? 1 : 0;
-      }
-  }
-  for (int v = 0; v < points.height(); ++v)
-    for (int u = 0; u < points.width(); ++u) {
-      const int l = label(u, v);
-      if (l < 0) continue;
-      ++won[size_t(l)];
-      const Eigen::Vector3f& pt = points(u, v);
-      const float tol = params.refine_distance(pt.z());
-      // the regions of this pixel's cell and its 8 neighbours: the candidates refinement used
-      const int cx = u / grid.size, cy = v / grid.size;
-      bool other = false;
-      for (int dy = -1; dy <= 1 && !other; ++dy)
-        for (int dx = -1; dx <= 1 && !other; ++dx) {
-          const int x = cx + dx, y = cy + dy;
-          if (x < 0 || y < 0 || x >= grid.nx || y >= grid.ny) continue;
-          const int r = region[size_t(grid.index(x, y))];
-          other = r >= 0 && r != l && std::abs(fits[size_t(r)].plane.signed_distance(pt)) < tol;
-        }
-      shared[size_t(l)] += other ? 1 : 0;
-    }
-  bool slivers = false;
-  std::vector<uint8_t> sliver(fits.size(), 0);
-  for (size_t r = 0; r < fits.size(); ++r)
-    sliver[r] = 2 * kept[r] < own[r] && 10 * shared[r] >= 9 * won[r];
-  for (int& r : region)
-    if (r >= 0 && sliver[size_t(r)]) r = -1, slivers = true;
-  if (slivers) label = refine_pixels(grid, points, params, region, fits);
+  if (drop_slivers(grid, points, params, label, fits, region))
+    label = refine_pixels(grid, points, params, region, fits);
 
   // Refit every plane to its pixels; drop the small ones; order by size.
   std::vector<PlaneMoments> moments(fits.size());

@@ -4,10 +4,11 @@
 //     test (valid depth, no depth jump along the cell's middle row/column, fit RMS within the
 //     sensor's noise);
 //  2. region growing seeded from the most populated bin of a histogram of cell normals (polar,
-//     azimuth), comparing neighbour cells with the seed's plane;
+//     azimuth), comparing neighbour cells with the region's plane (refitted as the region grows);
 //  3. merging of adjacent regions whose planes agree (normal angle and centroid distances);
 //  4. pixel-level boundary refinement: pixels of a region's cells and of the one-cell ring around
-//     them take the nearest plane within the distance threshold.
+//     them take the nearest plane within the distance threshold; slivers between planes (crease
+//     cells) are dropped and the pixels refined again.
 // Output: the per-pixel local plane map and the plane parameters (n, b) refitted to the pixels.
 #include "core/common/camera.h"
 #include "core/common/image.h"
