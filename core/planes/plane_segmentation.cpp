@@ -188,10 +188,9 @@ std::vector<PlaneFit> merge_regions(const CellGrid& g, const PlaneSegmentationPa
   return out;
 }
 
-// Step 4: pixel-level refinement. Each pixel of a region's cells and of the one-cell ring around
-// them takes the nearest candidate plane within the distance threshold.
-Image<int> refine_pixels(const CellGrid& g, const Image<Eigen::Vector3f>& points, const PlaneSegmentationParams& p,
-                         const std::vector<int>& region, const std::vector<PlaneFit>& fits) {
+// The candidate regions of every cell for pixel refinement: the regions of the cell and of its
+// one-cell ring.
+std::vector<std::vector<int>> candidate_regions(const CellGrid& g, const std::vector<int>& region) {
   std::vector<std::vector<int>> candidates(region.size());
   for (int cy = 0; cy < g.ny; ++cy)
     for (int cx = 0; cx < g.nx; ++cx) {
@@ -205,6 +204,14 @@ Image<int> refine_pixels(const CellGrid& g, const Image<Eigen::Vector3f>& points
           if (std::find(list.begin(), list.end(), r) == list.end()) list.push_back(r);
         }
     }
+  return candidates;
+}
+
+// Step 4: pixel-level refinement. Each pixel of a region's cells and of the one-cell ring around
+// them takes the nearest candidate plane within the distance threshold.
+Image<int> refine_pixels(const CellGrid& g, const Image<Eigen::Vector3f>& points, const PlaneSegmentationParams& p,
+                         const std::vector<int>& region, const std::vector<PlaneFit>& fits) {
+  const std::vector<std::vector<int>> candidates = candidate_regions(g, region);
   Image<int> label(points.width(), points.height(), -1);
 #pragma omp parallel for schedule(dynamic, 8)
   for (int c = 0; c < int(region.size()); ++c) {
@@ -237,36 +244,30 @@ Image<int> refine_pixels(const CellGrid& g, const Image<Eigen::Vector3f>& points
 // -1); returns whether any did, so that the pixels are refined again without them.
 bool drop_slivers(const CellGrid& g, const Image<Eigen::Vector3f>& points, const PlaneSegmentationParams& p,
                   const Image<int>& label, const std::vector<PlaneFit>& fits, std::vector<int>& region) {
+  const std::vector<std::vector<int>> candidates = candidate_regions(g, region);  // as refinement used
   std::vector<int64_t> own(fits.size(), 0), kept(fits.size(), 0), won(fits.size(), 0), shared(fits.size(), 0);
   for (int c = 0; c < int(region.size()); ++c) {
     const int r = region[size_t(c)];
-    if (r < 0) continue;
     const int x0 = g.x0(c % g.nx), y0 = g.y0(c / g.nx);
     for (int v = y0; v < std::min(y0 + g.size, points.height()); ++v)
       for (int u = x0; u < std::min(x0 + g.size, points.width()); ++u) {
-        if (points(u, v).z() <= 0.0f) continue;
-        ++own[size_t(r)];
-        kept[size_t(r)] += label(u, v) == r ? 1 : 0;
+        const Eigen::Vector3f& pt = points(u, v);
+        if (pt.z() <= 0.0f) continue;
+        const int l = label(u, v);
+        if (r >= 0) {
+          ++own[size_t(r)];
+          kept[size_t(r)] += l == r ? 1 : 0;
+        }
+        if (l < 0) continue;
+        ++won[size_t(l)];
+        const float tol = p.refine_distance(pt.z());
+        for (int q : candidates[size_t(c)])
+          if (q != l && std::abs(fits[size_t(q)].plane.signed_distance(pt)) < tol) {
+            ++shared[size_t(l)];
+            break;
+          }
       }
   }
-  for (int v = 0; v < points.height(); ++v)
-    for (int u = 0; u < points.width(); ++u) {
-      const int l = label(u, v);
-      if (l < 0) continue;
-      ++won[size_t(l)];
-      const Eigen::Vector3f& pt = points(u, v);
-      const float tol = p.refine_distance(pt.z());
-      const int cx = u / g.size, cy = v / g.size;  // candidates: the regions of this cell and its ring
-      bool other = false;
-      for (int dy = -1; dy <= 1 && !other; ++dy)
-        for (int dx = -1; dx <= 1 && !other; ++dx) {
-          const int x = cx + dx, y = cy + dy;
-          if (x < 0 || y < 0 || x >= g.nx || y >= g.ny) continue;
-          const int r = region[size_t(g.index(x, y))];
-          other = r >= 0 && r != l && std::abs(fits[size_t(r)].plane.signed_distance(pt)) < tol;
-        }
-      shared[size_t(l)] += other ? 1 : 0;
-    }
   bool any = false;
   for (int& r : region)
     if (r >= 0 && 2 * kept[size_t(r)] < own[size_t(r)] && 10 * shared[size_t(r)] >= 9 * won[size_t(r)]) {
