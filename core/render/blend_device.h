@@ -25,6 +25,37 @@ RRG_HD inline T splat_alpha(const SplatT<T>& s, T px, T py, T alpha_max) {
   return alpha < T(kAlphaMin) ? T(0) : alpha;
 }
 
+// The pixels where splat_alpha can be non-zero, as a rectangle [x0, x1] x [y0, y1] (inclusive,
+// pixel centres at integer coordinates); false when there are none (opacity below kAlphaMin).
+// alpha >= kAlphaMin needs q = d^T Sigma'^-1 d <= kappa = 2 ln(opacity / kAlphaMin), an ellipse
+// whose half-extents are sqrt(kappa (Sigma')_xx) and sqrt(kappa (Sigma')_yy), with Sigma' the
+// inverse of the conic. kappa is widened by 1e-3 relative so that float rounding of the per-pixel
+// test never admits a pixel outside. A conic that is not positive definite gives an unbounded rect.
+template <class T>
+RRG_HD inline bool splat_pixel_bounds(const SplatT<T>& s, int& x0, int& y0, int& x1, int& y1) {
+  if (s.opacity < T(kAlphaMin)) return false;  // (NaN goes on to the unbounded case below)
+  const T a = s.conic[0], b = s.conic[1], c = s.conic[2], det = a * c - b * b;
+  constexpr int kUnbounded = 1 << 28;
+  if (!(det > T(0)) || !(a > T(0))) {
+    x0 = y0 = -kUnbounded;
+    x1 = y1 = kUnbounded;
+    return true;
+  }
+  const T kappa = T(2.002) * k_log(s.opacity / T(kAlphaMin)) + T(1e-6);
+  const T ex = k_sqrt(kappa * c / det), ey = k_sqrt(kappa * a / det);
+  if (!(ex < T(kUnbounded) && ey < T(kUnbounded) && s.mean[0] == s.mean[0] && s.mean[1] == s.mean[1])) {
+    x0 = y0 = -kUnbounded;  // NaN or huge: let the per-pixel test decide everywhere
+    x1 = y1 = kUnbounded;
+    return true;
+  }
+  auto to_int = [](T v) { return v < T(-kUnbounded) ? -kUnbounded : (v > T(kUnbounded) ? kUnbounded : int(v)); };
+  x0 = to_int(k_ceil(s.mean[0] - ex));
+  x1 = to_int(k_floor(s.mean[0] + ex));
+  y0 = to_int(k_ceil(s.mean[1] - ey));
+  y1 = to_int(k_floor(s.mean[1] + ey));
+  return x0 <= x1 && y0 <= y1;
+}
+
 // v += d alpha / d(splat) * v_alpha, for an alpha splat_alpha returned non-zero.
 template <class T>
 RRG_HD inline void splat_alpha_bwd(const SplatT<T>& s, T px, T py, T alpha_max, T v_alpha, SplatT<T>& v) {

@@ -1,15 +1,195 @@
+// The CPU back end of the rasterisation passes. The per-pixel maths is blend_device.h's, as on
+// CUDA; only the schedule differs. CUDA runs one thread per pixel over the tile's splat list and
+// reduces gradients across a warp (rasterize_impl.h, grad_accumulate.cuh). A CPU thread instead
+// takes a whole 16 x 16 tile and walks the tile's splats in list order, visiting for each splat only
+// the pixels of the tile it can reach (splat_pixel_bounds). Every pixel therefore sees the same
+// splats in the same order as in the per-pixel loop (forward results are the same), pixels a splat
+// cannot reach cost nothing, and a splat's gradient is summed over the tile locally and added to
+// the shared one once per (tile, splat) instead of once per (pixel, splat).
 #include "core/common/parallel_for.h"
 #include "core/render/rasterize_impl.h"
 
+#include <algorithm>
+
 namespace rrg::kernel {
 
-void base_fwd_cpu(BaseFwdArgs a) { base_fwd(CpuBackend{}, a); }
+namespace {
 
-void base_bwd_cpu(BaseBwdArgs a) { base_bwd(CpuBackend{}, a); }
+constexpr int kTilePixels = kTileSize * kTileSize;
 
-void refl_fwd_cpu(ReflFwdArgs a) { refl_fwd(CpuBackend{}, a); }
+// A tile's pixels [x0, x1) x [y0, y1), clipped to the image; pixel (x, y) is at local index
+// (y - y0) * kTileSize + (x - x0).
+struct TilePixels {
+  int x0, y0, x1, y1;
+  int local(int x, int y) const { return (y - y0) * kTileSize + (x - x0); }
+};
 
-void refl_bwd_cpu(ReflBwdArgs a) { refl_bwd(CpuBackend{}, a); }
+TilePixels tile_pixels(const View& v, int tile) {
+  const int x0 = (tile % v.tiles_x()) * kTileSize, y0 = (tile / v.tiles_x()) * kTileSize;
+  return {x0, y0, std::min(x0 + kTileSize, v.width), std::min(y0 + kTileSize, v.height)};
+}
+
+// The pixels of tile t that splat s can reach; false when none.
+bool reach(const Splat& s, const TilePixels& t, TilePixels& out) {
+  int x0, y0, x1, y1;
+  if (!splat_pixel_bounds(s, x0, y0, x1, y1)) return false;
+  out = {std::max(x0, t.x0), std::max(y0, t.y0), std::min(x1 + 1, t.x1), std::min(y1 + 1, t.y1)};
+  return out.x0 < out.x1 && out.y0 < out.y1;
+}
+
+// f(tile) for every tile on OpenMP threads; tiles differ in work, so they are handed out one by one.
+template <class F>
+void for_each_tile(const View& v, F f) {
+  const int tiles = v.tiles_x() * v.tiles_y();
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int t = 0; t < tiles; ++t) f(t);
+}
+
+}  // namespace
+
+void base_fwd_cpu(BaseFwdArgs a) {
+  for_each_tile(a.view, [&](int tile) {
+    const TilePixels tp = tile_pixels(a.view, tile);
+    BaseAccumT<float> acc[kTilePixels];
+    float D_t[kTilePixels];
+    for (int y = tp.y0; y < tp.y1; ++y)
+      for (int x = tp.x0; x < tp.x1; ++x) D_t[tp.local(x, y)] = a.D_t(x, y);
+    const TileRange r = a.bins.ranges[tile];
+    for (int32_t k = r.begin; k < r.end; ++k) {
+      const Splat& s = a.splats[a.bins.values[k]];
+      TilePixels p;
+      if (!reach(s, tp, p)) continue;
+      for (int y = p.y0; y < p.y1; ++y)
+        for (int x = p.x0; x < p.x1; ++x) {
+          const int l = tp.local(x, y);
+          base_accumulate(acc[l], s, float(x), float(y), D_t[l], a.eps);
+        }
+    }
+    for (int y = tp.y0; y < tp.y1; ++y)
+      for (int x = tp.x0; x < tp.x1; ++x) {
+        const int l = tp.local(x, y);
+        Vec3<float> C_b;
+        float D_b;
+        base_resolve(acc[l], Vec3<float>(a.C_t(x, y)), D_t[l], C_b, D_b);
+        a.C_g(x, y) = acc[l].C_g;
+        a.W_g(x, y) = acc[l].W_g;
+        a.D_g(x, y) = acc[l].D_g;
+        a.C_b(x, y) = C_b;
+        a.D_b(x, y) = D_b;
+      }
+  });
+}
+
+void base_bwd_cpu(BaseBwdArgs a) {
+  for_each_tile(a.view, [&](int tile) {
+    const TilePixels tp = tile_pixels(a.view, tile);
+    BaseUpstreamT<float> up[kTilePixels];
+    float D_t[kTilePixels];
+    bool active[kTilePixels] = {};
+    bool any = false;
+    for (int y = tp.y0; y < tp.y1; ++y)
+      for (int x = tp.x0; x < tp.x1; ++x) {
+        const int l = tp.local(x, y);
+        const Vec3<float> v_C_b = a.v_C_b(x, y);
+        const float v_D_b = a.v_D_b(x, y);
+        if (v_C_b.isZero() && v_D_b == 0.0f) continue;
+        active[l] = any = true;
+        D_t[l] = a.D_t(x, y);
+        up[l] = base_resolve_bwd(a.W_g(x, y), D_t[l], Vec3<float>(a.C_b(x, y)), a.D_b(x, y), v_C_b, v_D_b);
+      }
+    if (!any) return;
+    const TileRange r = a.bins.ranges[tile];
+    for (int32_t k = r.begin; k < r.end; ++k) {
+      const int32_t g = a.bins.values[k];
+      const Splat& s = a.splats[g];
+      TilePixels p;
+      if (!reach(s, tp, p)) continue;
+      SplatGrad v{};
+      for (int y = p.y0; y < p.y1; ++y)
+        for (int x = p.x0; x < p.x1; ++x) {
+          const int l = tp.local(x, y);
+          if (active[l]) base_splat_bwd(s, float(x), float(y), D_t[l], a.eps, up[l], v);
+        }
+      if (!is_zero(v)) accumulate_grad(CpuBackend{}, &a.v_splats[g], v);
+    }
+  });
+}
+
+void refl_fwd_cpu(ReflFwdArgs a) {
+  for_each_tile(a.view, [&](int tile) {
+    const TilePixels tp = tile_pixels(a.view, tile);
+    ReflStateT<float> st[kTilePixels];
+    int32_t I[kTilePixels];
+    bool alive[kTilePixels] = {};
+    int live = 0;
+    for (int y = tp.y0; y < tp.y1; ++y)
+      for (int x = tp.x0; x < tp.x1; ++x) {
+        const int l = tp.local(x, y);
+        I[l] = a.I(x, y);
+        alive[l] = refl_pixel_active(a.mode, a.plane, I[l]);
+        live += alive[l] ? 1 : 0;
+      }
+    const TileRange r = a.bins.ranges[tile];
+    for (int32_t k = r.begin; k < r.end && live > 0; ++k) {
+      const int32_t g = a.bins.values[k];
+      const Splat& s = a.splats[g];
+      TilePixels p;
+      if (!reach(s, tp, p)) continue;
+      for (int y = p.y0; y < p.y1; ++y)
+        for (int x = p.x0; x < p.x1; ++x) {
+          const int l = tp.local(x, y);
+          if (!alive[l] || (a.mode == PlaneMode::Match && a.plane_ids[g] != I[l])) continue;  // 1(l_i == I(u))
+          if (!refl_step(st[l], s, float(x), float(y))) alive[l] = false, --live;           // early termination
+        }
+    }
+    for (int y = tp.y0; y < tp.y1; ++y)
+      for (int x = tp.x0; x < tp.x1; ++x) {
+        const int l = tp.local(x, y);
+        a.C_r(x, y) = st[l].C;
+        a.W_r(x, y) = st[l].W;
+      }
+  });
+}
+
+void refl_bwd_cpu(ReflBwdArgs a) {
+  for_each_tile(a.view, [&](int tile) {
+    const TilePixels tp = tile_pixels(a.view, tile);
+    ReflStateT<float> st[kTilePixels];
+    Vec3<float> v_C[kTilePixels], C_final[kTilePixels];
+    float W_final[kTilePixels];
+    int32_t I[kTilePixels];
+    bool alive[kTilePixels] = {};
+    int live = 0;
+    for (int y = tp.y0; y < tp.y1; ++y)
+      for (int x = tp.x0; x < tp.x1; ++x) {
+        const int l = tp.local(x, y);
+        I[l] = a.I(x, y);
+        if (!refl_pixel_active(a.mode, a.plane, I[l])) continue;
+        v_C[l] = a.v_C_r(x, y);
+        if (v_C[l].isZero()) continue;
+        C_final[l] = a.C_r(x, y);
+        W_final[l] = a.W_r(x, y);
+        alive[l] = true;
+        ++live;
+      }
+    const TileRange r = a.bins.ranges[tile];
+    for (int32_t k = r.begin; k < r.end && live > 0; ++k) {
+      const int32_t g = a.bins.values[k];
+      const Splat& s = a.splats[g];
+      TilePixels p;
+      if (!reach(s, tp, p)) continue;
+      SplatGrad v{};
+      for (int y = p.y0; y < p.y1; ++y)
+        for (int x = p.x0; x < p.x1; ++x) {
+          const int l = tp.local(x, y);
+          if (!alive[l] || (a.mode == PlaneMode::Match && a.plane_ids[g] != I[l])) continue;
+          if (!refl_step_bwd(st[l], s, float(x), float(y), C_final[l], W_final[l], v_C[l], 0.0f, v))
+            alive[l] = false, --live;
+        }
+      if (!is_zero(v)) accumulate_grad(CpuBackend{}, &a.v_splats[g], v);
+    }
+  });
+}
 
 void composite_cpu(ImageView<const Eigen::Vector3f> C_b, ImageView<const float> R,
                    ImageView<const Eigen::Vector3f> C_r, ImageView<Eigen::Vector3f> C) {

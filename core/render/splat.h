@@ -20,6 +20,8 @@ template <class T> using Mat23 = Eigen::Matrix<T, 2, 3>;
 // Scalar maths with the float overloads picked explicitly (no silent promotion on the host).
 RRG_HD inline float k_exp(float x) { return expf(x); }
 RRG_HD inline double k_exp(double x) { return exp(x); }
+RRG_HD inline float k_log(float x) { return logf(x); }
+RRG_HD inline double k_log(double x) { return log(x); }
 RRG_HD inline float k_sqrt(float x) { return sqrtf(x); }
 RRG_HD inline double k_sqrt(double x) { return sqrt(x); }
 RRG_HD inline float k_ceil(float x) { return ceilf(x); }

@@ -1,0 +1,268 @@
+// The CPU back end runs passes 2 and 3 tile by tile, splat-major, visiting only the pixels a splat
+// can reach (rasterize_cpu.cpp); CUDA runs them pixel by pixel (rasterize_impl.h). These tests run
+// the per-pixel template on the CPU as the reference and require the same images and gradients,
+// on splats chosen to stress the reach bound: thin and rotated ellipses, huge ones, opacities around
+// the 1/255 cut, splats centred off the image and off their tiles.
+#include "core/common/parallel_for.h"
+#include "core/render/rasterize_impl.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+namespace rrg::kernel {
+namespace {
+
+struct Scene {
+  int w = 70, h = 45;  // partial tiles on the right and bottom
+  View view{};
+  std::vector<Splat> splats;
+  std::vector<int32_t> plane_ids;
+  std::vector<int32_t> values;
+  std::vector<TileRange> ranges;
+  std::vector<Eigen::Vector3f> C_t, v_C, C_r_in;
+  std::vector<float> D_t, v_D;
+  std::vector<int32_t> I;
+};
+
+Splat random_splat(std::mt19937& rng, int w, int h) {
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  Splat s{};
+  s.mean[0] = -10.0f + u(rng) * float(w + 20);
+  s.mean[1] = -10.0f + u(rng) * float(h + 20);
+  // Sigma' = R diag(l1, l2) R^T with l in [0.05, 40] px^2 (a few huge), then the conic is its inverse.
+  const float th = u(rng) * 6.2831853f;
+  float l1 = 0.05f + u(rng) * 12.0f, l2 = 0.05f + u(rng) * u(rng) * 40.0f;
+  if (u(rng) < 0.05f) l1 = 400.0f;  // reaches across tiles
+  const float c = std::cos(th), sn = std::sin(th);
+  const float sxx = c * c * l1 + sn * sn * l2, syy = sn * sn * l1 + c * c * l2, sxy = c * sn * (l1 - l2);
+  const float det = sxx * syy - sxy * sxy;
+  s.conic[0] = syy / det;
+  s.conic[1] = -sxy / det;
+  s.conic[2] = sxx / det;
+  const float pick = u(rng);
+  s.opacity = pick < 0.1f ? kAlphaMin * (0.5f + u(rng)) : (pick < 0.2f ? 1.0f : u(rng));
+  for (float& ch : s.color) ch = u(rng);
+  s.depth = 0.5f + 3.0f * u(rng);
+  return s;
+}
+
+Scene make_scene(uint32_t seed, int n) {
+  Scene sc;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  sc.view.width = sc.w;
+  sc.view.height = sc.h;
+  for (int i = 0; i < n; ++i) {
+    sc.splats.push_back(random_splat(rng, sc.w, sc.h));
+    sc.plane_ids.push_back(int32_t(rng() % 3));
+  }
+  // Every tile lists every splat, in a per-tile shuffled order: lists longer than any binning
+  // would make, and splats far from the tile (nothing may reach there).
+  const int tiles = sc.view.tiles_x() * sc.view.tiles_y();
+  for (int t = 0; t < tiles; ++t) {
+    std::vector<int32_t> order(static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i) order[size_t(i)] = i;
+    std::shuffle(order.begin(), order.end(), rng);
+    sc.ranges.push_back({int32_t(sc.values.size()), int32_t(sc.values.size() + order.size())});
+    sc.values.insert(sc.values.end(), order.begin(), order.end());
+  }
+  const size_t px = size_t(sc.w) * size_t(sc.h);
+  for (size_t i = 0; i < px; ++i) {
+    sc.C_t.emplace_back(u(rng), u(rng), u(rng));
+    sc.D_t.push_back(u(rng) < 0.15f ? 0.0f : 0.5f + 3.0f * u(rng));  // some raycast misses
+    sc.v_C.emplace_back(u(rng) < 0.1f ? Eigen::Vector3f::Zero() : Eigen::Vector3f(u(rng) - 0.5f, u(rng) - 0.5f, u(rng) - 0.5f));
+    sc.v_D.push_back(u(rng) < 0.5f ? 0.0f : u(rng) - 0.5f);
+    sc.I.push_back(int32_t(rng() % 3));
+  }
+  return sc;
+}
+
+template <class T>
+ImageView<T> img(std::vector<T>& v, const Scene& sc) {
+  return {v.data(), sc.w, sc.h};
+}
+template <class T>
+ImageView<const T> cimg(const std::vector<T>& v, const Scene& sc) {
+  return {v.data(), sc.w, sc.h};
+}
+template <class T>
+Span<const T> cspan(const std::vector<T>& v) {
+  return {v.data(), int64_t(v.size())};
+}
+
+struct BaseOut {
+  std::vector<Eigen::Vector3f> C_g, C_b;
+  std::vector<float> W_g, D_g, D_b;
+  explicit BaseOut(size_t n) : C_g(n), C_b(n), W_g(n), D_g(n), D_b(n) {}
+};
+
+BaseFwdArgs base_fwd_args(Scene& sc, BaseOut& o) {
+  BaseFwdArgs a{};
+  a.view = sc.view;
+  a.eps = 0.05f;
+  a.splats = cspan(sc.splats);
+  a.bins = {cspan(sc.values), cspan(sc.ranges)};
+  a.C_t = cimg(sc.C_t, sc);
+  a.D_t = cimg(sc.D_t, sc);
+  a.C_g = img(o.C_g, sc);
+  a.C_b = img(o.C_b, sc);
+  a.W_g = img(o.W_g, sc);
+  a.D_g = img(o.D_g, sc);
+  a.D_b = img(o.D_b, sc);
+  return a;
+}
+
+void expect_close(const SplatGrad& got, const SplatGrad& want, int g) {
+  const float* a = &got.mean[0];
+  const float* b = &want.mean[0];
+  for (int k = 0; k < int(sizeof(SplatGrad) / sizeof(float)); ++k)
+    EXPECT_NEAR(a[k], b[k], 1e-4f * (1.0f + std::abs(b[k]))) << "splat " << g << " field " << k;
+}
+
+TEST(RasterizeSchedule, NoPixelOutsideTheReachBoundHasAnAlpha) {
+  std::mt19937 rng(7);
+  int64_t inside_hits = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const Splat s = random_splat(rng, 40, 40);
+    int x0, y0, x1, y1;
+    const bool any = splat_pixel_bounds(s, x0, y0, x1, y1);
+    for (int y = -40; y < 90; ++y)
+      for (int x = -40; x < 90; ++x) {
+        const float alpha = splat_alpha(s, float(x), float(y), 1.0f);
+        const bool in = any && x >= x0 && x <= x1 && y >= y0 && y <= y1;
+        if (!in) ASSERT_EQ(alpha, 0.0f) << "splat " << i << " pixel " << x << "," << y;
+        inside_hits += in && alpha > 0.0f ? 1 : 0;
+      }
+    if (s.opacity < kAlphaMin) EXPECT_FALSE(any);
+  }
+  EXPECT_GT(inside_hits, 100000);  // the bound is not empty where splats are visible
+}
+
+TEST(RasterizeSchedule, BoundIsTightToTheEllipse) {
+  // An axis-aligned splat with sigma 2 px (x) and 1 px (y), opacity 1: alpha >= 1/255 out to
+  // sqrt(2 ln 255) sigma = 3.33 sigma, so x in [-6, 6] and y in [-3, 3] around (20, 20).
+  Splat s{};
+  s.mean[0] = 20.0f;
+  s.mean[1] = 20.0f;
+  s.conic[0] = 1.0f / 4.0f;
+  s.conic[1] = 0.0f;
+  s.conic[2] = 1.0f;
+  s.opacity = 1.0f;
+  int x0, y0, x1, y1;
+  ASSERT_TRUE(splat_pixel_bounds(s, x0, y0, x1, y1));
+  EXPECT_EQ(x0, 14);
+  EXPECT_EQ(x1, 26);
+  EXPECT_EQ(y0, 17);
+  EXPECT_EQ(y1, 23);
+}
+
+TEST(RasterizeSchedule, BasePassMatchesThePerPixelLoop) {
+  Scene sc = make_scene(11, 300);
+  const size_t n = sc.C_t.size();
+  BaseOut tiled(n), pixel(n);
+  base_fwd_cpu(base_fwd_args(sc, tiled));
+  base_fwd(CpuBackend{}, base_fwd_args(sc, pixel));
+  int64_t covered = 0;
+  for (size_t i = 0; i < n; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(tiled.C_g[i][k], pixel.C_g[i][k], 1e-6f * (1.0f + std::abs(pixel.C_g[i][k]))) << i;
+      EXPECT_NEAR(tiled.C_b[i][k], pixel.C_b[i][k], 1e-6f) << i;
+    }
+    EXPECT_NEAR(tiled.W_g[i], pixel.W_g[i], 1e-6f * (1.0f + pixel.W_g[i])) << i;
+    EXPECT_NEAR(tiled.D_g[i], pixel.D_g[i], 1e-6f * (1.0f + pixel.D_g[i])) << i;
+    EXPECT_NEAR(tiled.D_b[i], pixel.D_b[i], 1e-6f * (1.0f + pixel.D_b[i])) << i;
+    covered += pixel.W_g[i] > 0.0f ? 1 : 0;
+  }
+  EXPECT_GT(covered, int64_t(n) * 9 / 10);
+
+  // Backward from random upstream gradients (zero at some pixels).
+  BaseBwdArgs b{};
+  b.view = sc.view;
+  b.eps = 0.05f;
+  b.splats = cspan(sc.splats);
+  b.bins = {cspan(sc.values), cspan(sc.ranges)};
+  b.D_t = cimg(sc.D_t, sc);
+  b.W_g = cimg(pixel.W_g, sc);
+  b.D_b = cimg(pixel.D_b, sc);
+  b.C_b = cimg(pixel.C_b, sc);
+  b.v_C_b = cimg(sc.v_C, sc);
+  b.v_D_b = cimg(sc.v_D, sc);
+  std::vector<SplatGrad> g_tiled(sc.splats.size(), SplatGrad{}), g_pixel(sc.splats.size(), SplatGrad{});
+  b.v_splats = {g_tiled.data(), int64_t(g_tiled.size())};
+  base_bwd_cpu(b);
+  b.v_splats = {g_pixel.data(), int64_t(g_pixel.size())};
+  base_bwd(CpuBackend{}, b);
+  int nonzero = 0;
+  for (size_t g = 0; g < g_pixel.size(); ++g) {
+    expect_close(g_tiled[g], g_pixel[g], int(g));
+    nonzero += is_zero(g_pixel[g]) ? 0 : 1;
+  }
+  EXPECT_GT(nonzero, 200);
+}
+
+class ReflSchedule : public ::testing::TestWithParam<PlaneMode> {};
+
+TEST_P(ReflSchedule, ReflectionPassMatchesThePerPixelLoop) {
+  Scene sc = make_scene(23, 300);
+  // Pass 3 composites front to back: sort every tile's list by depth, as the binning does.
+  for (const TileRange& r : sc.ranges)
+    std::stable_sort(sc.values.begin() + r.begin, sc.values.begin() + r.end,
+                     [&](int32_t p, int32_t q) { return sc.splats[size_t(p)].depth < sc.splats[size_t(q)].depth; });
+  const size_t n = sc.C_t.size();
+  std::vector<Eigen::Vector3f> C_tiled(n), C_pixel(n);
+  std::vector<float> W_tiled(n), W_pixel(n);
+  ReflFwdArgs a{};
+  a.view = sc.view;
+  a.splats = cspan(sc.splats);
+  a.bins = {cspan(sc.values), cspan(sc.ranges)};
+  a.plane_ids = cspan(sc.plane_ids);
+  a.I = cimg(sc.I, sc);
+  a.mode = GetParam();
+  a.plane = 1;
+  a.C_r = img(C_tiled, sc);
+  a.W_r = img(W_tiled, sc);
+  refl_fwd_cpu(a);
+  a.C_r = img(C_pixel, sc);
+  a.W_r = img(W_pixel, sc);
+  refl_fwd(CpuBackend{}, a);
+  int64_t saturated = 0;
+  for (size_t i = 0; i < n; ++i) {
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(C_tiled[i][k], C_pixel[i][k], 1e-6f) << i;
+    EXPECT_NEAR(W_tiled[i], W_pixel[i], 1e-6f) << i;
+    saturated += W_pixel[i] > 0.99f ? 1 : 0;
+  }
+  EXPECT_GT(saturated, 0);  // early termination is exercised
+
+  ReflBwdArgs b{};
+  b.view = sc.view;
+  b.splats = cspan(sc.splats);
+  b.bins = {cspan(sc.values), cspan(sc.ranges)};
+  b.plane_ids = cspan(sc.plane_ids);
+  b.I = cimg(sc.I, sc);
+  b.mode = GetParam();
+  b.plane = 1;
+  b.C_r = cimg(C_pixel, sc);
+  b.W_r = cimg(W_pixel, sc);
+  b.v_C_r = cimg(sc.v_C, sc);
+  std::vector<SplatGrad> g_tiled(sc.splats.size(), SplatGrad{}), g_pixel(sc.splats.size(), SplatGrad{});
+  b.v_splats = {g_tiled.data(), int64_t(g_tiled.size())};
+  refl_bwd_cpu(b);
+  b.v_splats = {g_pixel.data(), int64_t(g_pixel.size())};
+  refl_bwd(CpuBackend{}, b);
+  int nonzero = 0;
+  for (size_t g = 0; g < g_pixel.size(); ++g) {
+    expect_close(g_tiled[g], g_pixel[g], int(g));
+    nonzero += is_zero(g_pixel[g]) ? 0 : 1;
+  }
+  EXPECT_GT(nonzero, 100);
+}
+
+INSTANTIATE_TEST_SUITE_P(Modes, ReflSchedule,
+                         ::testing::Values(PlaneMode::Match, PlaneMode::All, PlaneMode::PixelOnly));
+
+}  // namespace
+}  // namespace rrg::kernel
