@@ -49,7 +49,10 @@ struct RunMetrics {
   size_t frames = 0, lost = 0;
   std::optional<double> ate_rmse_cm;          // rigid SE(3) Umeyama alignment
   ImageScores train, held_out;                // held_out only with a novel/ folder (synth)
-  std::optional<double> accuracy_cm, completion_cm, completion_ratio;  // with a ground-truth mesh
+  // With a ground-truth mesh: accuracy; completion and its ratio (< 3 cm) over the part of the
+  // ground-truth surface the input frames observed (eval/observed_surface.h); completion over the
+  // whole mesh; the observed fraction of its area.
+  std::optional<double> accuracy_cm, completion_cm, completion_ratio, completion_whole_cm, observed_fraction;
   double wall_s = 0, fps = 0;                 // whole run, frames / wall time (loading included)
   int64_t base_gaussians = 0, reflection_gaussians = 0, reflective_planes = 0;
 };
