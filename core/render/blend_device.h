@@ -13,16 +13,38 @@ inline constexpr float kTransmittanceMin = 1e-4f;    // pass 3 stops before T dr
 // before the exp (an exact shortcut, not a new threshold).
 inline constexpr float kPowerMin = -5.5422645f;
 
-// alpha_i(u) = min(sigma_i exp(-1/2 (u - p_hat)^T Sigma'^-1 (u - p_hat)), alpha_max), or 0 when
-// below kAlphaMin (or the exponent is positive, as in 3DGS).
+// The falloff of splat s at pixel (px, py): offset d = p_hat - u and G = exp(power), with
+// power = -1/2 d^T Sigma'^-1 d. valid is false when the exponent is positive (as in 3DGS) or below
+// kPowerMin (alpha < kAlphaMin for any opacity <= 1); G is not computed then.
 template <class T>
-RRG_HD inline T splat_alpha(const SplatT<T>& s, T px, T py, T alpha_max) {
-  const T dx = s.mean[0] - px, dy = s.mean[1] - py;
-  const T power = T(-0.5) * (s.conic[0] * dx * dx + s.conic[2] * dy * dy) - s.conic[1] * dx * dy;
-  if (power > T(0) || power < T(kPowerMin)) return T(0);
-  T alpha = s.opacity * k_exp(power);
+struct SplatFalloffT {
+  T dx, dy, G;
+  bool valid;
+};
+
+template <class T>
+RRG_HD inline SplatFalloffT<T> splat_falloff(const SplatT<T>& s, T px, T py) {
+  SplatFalloffT<T> f;
+  f.dx = s.mean[0] - px;
+  f.dy = s.mean[1] - py;
+  const T power = T(-0.5) * (s.conic[0] * f.dx * f.dx + s.conic[2] * f.dy * f.dy) - s.conic[1] * f.dx * f.dy;
+  f.valid = !(power > T(0) || power < T(kPowerMin));
+  f.G = f.valid ? k_exp(power) : T(0);
+  return f;
+}
+
+// alpha_i(u) = min(sigma_i G, alpha_max), or 0 when below kAlphaMin or the falloff is not valid.
+template <class T>
+RRG_HD inline T splat_alpha(const SplatT<T>& s, const SplatFalloffT<T>& f, T alpha_max) {
+  if (!f.valid) return T(0);
+  T alpha = s.opacity * f.G;
   if (alpha > alpha_max) alpha = alpha_max;
   return alpha < T(kAlphaMin) ? T(0) : alpha;
+}
+
+template <class T>
+RRG_HD inline T splat_alpha(const SplatT<T>& s, T px, T py, T alpha_max) {
+  return splat_alpha(s, splat_falloff(s, px, py), alpha_max);
 }
 
 // The pixels where splat_alpha can be non-zero, as a rectangle [x0, x1] x [y0, y1] (inclusive,
@@ -56,12 +78,10 @@ RRG_HD inline bool splat_pixel_bounds(const SplatT<T>& s, int& x0, int& y0, int&
   return x0 <= x1 && y0 <= y1;
 }
 
-// v += d alpha / d(splat) * v_alpha, for an alpha splat_alpha returned non-zero.
+// v += d alpha / d(splat) * v_alpha, for an alpha splat_alpha returned non-zero from falloff f.
 template <class T>
-RRG_HD inline void splat_alpha_bwd(const SplatT<T>& s, T px, T py, T alpha_max, T v_alpha, SplatT<T>& v) {
-  const T dx = s.mean[0] - px, dy = s.mean[1] - py;
-  const T power = T(-0.5) * (s.conic[0] * dx * dx + s.conic[2] * dy * dy) - s.conic[1] * dx * dy;
-  const T G = k_exp(power);
+RRG_HD inline void splat_alpha_bwd(const SplatT<T>& s, const SplatFalloffT<T>& f, T alpha_max, T v_alpha, SplatT<T>& v) {
+  const T dx = f.dx, dy = f.dy, G = f.G;
   if (s.opacity * G > alpha_max) return;  // clamped: constant
   v.opacity += G * v_alpha;
   const T v_power = s.opacity * G * v_alpha;
@@ -140,13 +160,14 @@ template <class T>
 RRG_HD inline void base_splat_bwd(const SplatT<T>& s, T px, T py, T D_t, T eps, const BaseUpstreamT<T>& u,
                                   SplatT<T>& v) {
   if (!base_visible(s, D_t, eps)) return;
-  const T alpha = splat_alpha(s, px, py, T(1));
+  const SplatFalloffT<T> f = splat_falloff(s, px, py);
+  const T alpha = splat_alpha(s, f, T(1));
   if (alpha == T(0)) return;
   const Vec3<T> c(s.color[0], s.color[1], s.color[2]);
   const T v_alpha = u.v_C_g.dot(c) + u.v_W_g + u.v_D_g * s.depth;
   for (int ch = 0; ch < 3; ++ch) v.color[ch] += alpha * u.v_C_g[ch];
   v.depth += alpha * u.v_D_g;
-  splat_alpha_bwd(s, px, py, T(1), v_alpha, v);
+  splat_alpha_bwd(s, f, T(1), v_alpha, v);
 }
 
 // ---- pass 3: A_r[x](u) = sum_i prod_{j<i} (1 - alpha_j) alpha_i x_i, alpha with 1(l_i == I(u)) ------
@@ -178,7 +199,8 @@ RRG_HD inline bool refl_step(ReflStateT<T>& st, const SplatT<T>& s, T px, T py) 
 template <class T>
 RRG_HD inline bool refl_step_bwd(ReflStateT<T>& st, const SplatT<T>& s, T px, T py, const Vec3<T>& C_final,
                                  T W_final, const Vec3<T>& v_C, T v_W, SplatT<T>& v) {
-  const T alpha = splat_alpha(s, px, py, T(kAlphaMax));
+  const SplatFalloffT<T> f = splat_falloff(s, px, py);
+  const T alpha = splat_alpha(s, f, T(kAlphaMax));
   if (alpha == T(0)) return true;
   const T next = st.trans * (T(1) - alpha);
   if (next < T(kTransmittanceMin)) return false;
@@ -189,7 +211,7 @@ RRG_HD inline bool refl_step_bwd(ReflStateT<T>& st, const SplatT<T>& s, T px, T 
   const T inv = T(1) / (T(1) - alpha);
   const T v_alpha = v_C.dot(st.trans * c - (C_final - st.C) * inv) + v_W * (st.trans - (W_final - st.W) * inv);
   for (int ch = 0; ch < 3; ++ch) v.color[ch] += w * v_C[ch];
-  splat_alpha_bwd(s, px, py, T(kAlphaMax), v_alpha, v);
+  splat_alpha_bwd(s, f, T(kAlphaMax), v_alpha, v);
   st.trans = next;
   return true;
 }

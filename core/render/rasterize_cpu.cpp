@@ -10,6 +10,7 @@
 #include "core/render/rasterize_impl.h"
 
 #include <algorithm>
+#include <vector>
 
 namespace rrg::kernel {
 
@@ -29,11 +30,22 @@ TilePixels tile_pixels(const View& v, int tile) {
   return {x0, y0, std::min(x0 + kTileSize, v.width), std::min(y0 + kTileSize, v.height)};
 }
 
-// The pixels of tile t that splat s can reach; false when none.
-bool reach(const Splat& s, const TilePixels& t, TilePixels& out) {
-  int x0, y0, x1, y1;
-  if (!splat_pixel_bounds(s, x0, y0, x1, y1)) return false;
-  out = {std::max(x0, t.x0), std::max(y0, t.y0), std::min(x1 + 1, t.x1), std::min(y1 + 1, t.y1)};
+// Every splat's reachable pixels [x0, x1) x [y0, y1) (splat_pixel_bounds), computed once per pass
+// rather than once per (tile, splat) entry; empty (x0 = x1) when it reaches none.
+std::vector<TilePixels> splat_reach(Span<const Splat> splats) {
+  std::vector<TilePixels> out(size_t(splats.size));
+#pragma omp parallel for schedule(static)
+  for (int64_t g = 0; g < splats.size; ++g) {
+    int x0, y0, x1, y1;
+    out[size_t(g)] = splat_pixel_bounds(splats[g], x0, y0, x1, y1) ? TilePixels{x0, y0, x1 + 1, y1 + 1}
+                                                                    : TilePixels{0, 0, 0, 0};
+  }
+  return out;
+}
+
+// The pixels of tile t within a splat's reach; false when none.
+bool reach(const TilePixels& splat, const TilePixels& t, TilePixels& out) {
+  out = {std::max(splat.x0, t.x0), std::max(splat.y0, t.y0), std::min(splat.x1, t.x1), std::min(splat.y1, t.y1)};
   return out.x0 < out.x1 && out.y0 < out.y1;
 }
 
@@ -48,6 +60,7 @@ void for_each_tile(const View& v, F f) {
 }  // namespace
 
 void base_fwd_cpu(BaseFwdArgs a) {
+  const std::vector<TilePixels> bounds = splat_reach(a.splats);
   for_each_tile(a.view, [&](int tile) {
     const TilePixels tp = tile_pixels(a.view, tile);
     BaseAccumT<float> acc[kTilePixels];
@@ -56,9 +69,10 @@ void base_fwd_cpu(BaseFwdArgs a) {
       for (int x = tp.x0; x < tp.x1; ++x) D_t[tp.local(x, y)] = a.D_t(x, y);
     const TileRange r = a.bins.ranges[tile];
     for (int32_t k = r.begin; k < r.end; ++k) {
-      const Splat& s = a.splats[a.bins.values[k]];
+      const int32_t g = a.bins.values[k];
       TilePixels p;
-      if (!reach(s, tp, p)) continue;
+      if (!reach(bounds[size_t(g)], tp, p)) continue;
+      const Splat& s = a.splats[g];
       for (int y = p.y0; y < p.y1; ++y)
         for (int x = p.x0; x < p.x1; ++x) {
           const int l = tp.local(x, y);
@@ -81,6 +95,7 @@ void base_fwd_cpu(BaseFwdArgs a) {
 }
 
 void base_bwd_cpu(BaseBwdArgs a) {
+  const std::vector<TilePixels> bounds = splat_reach(a.splats);
   for_each_tile(a.view, [&](int tile) {
     const TilePixels tp = tile_pixels(a.view, tile);
     BaseUpstreamT<float> up[kTilePixels];
@@ -101,9 +116,9 @@ void base_bwd_cpu(BaseBwdArgs a) {
     const TileRange r = a.bins.ranges[tile];
     for (int32_t k = r.begin; k < r.end; ++k) {
       const int32_t g = a.bins.values[k];
-      const Splat& s = a.splats[g];
       TilePixels p;
-      if (!reach(s, tp, p)) continue;
+      if (!reach(bounds[size_t(g)], tp, p)) continue;
+      const Splat& s = a.splats[g];
       SplatGrad v{};
       for (int y = p.y0; y < p.y1; ++y)
         for (int x = p.x0; x < p.x1; ++x) {
@@ -116,6 +131,7 @@ void base_bwd_cpu(BaseBwdArgs a) {
 }
 
 void refl_fwd_cpu(ReflFwdArgs a) {
+  const std::vector<TilePixels> bounds = splat_reach(a.splats);
   for_each_tile(a.view, [&](int tile) {
     const TilePixels tp = tile_pixels(a.view, tile);
     ReflStateT<float> st[kTilePixels];
@@ -132,9 +148,9 @@ void refl_fwd_cpu(ReflFwdArgs a) {
     const TileRange r = a.bins.ranges[tile];
     for (int32_t k = r.begin; k < r.end && live > 0; ++k) {
       const int32_t g = a.bins.values[k];
-      const Splat& s = a.splats[g];
       TilePixels p;
-      if (!reach(s, tp, p)) continue;
+      if (!reach(bounds[size_t(g)], tp, p)) continue;
+      const Splat& s = a.splats[g];
       for (int y = p.y0; y < p.y1; ++y)
         for (int x = p.x0; x < p.x1; ++x) {
           const int l = tp.local(x, y);
@@ -152,6 +168,7 @@ void refl_fwd_cpu(ReflFwdArgs a) {
 }
 
 void refl_bwd_cpu(ReflBwdArgs a) {
+  const std::vector<TilePixels> bounds = splat_reach(a.splats);
   for_each_tile(a.view, [&](int tile) {
     const TilePixels tp = tile_pixels(a.view, tile);
     ReflStateT<float> st[kTilePixels];
@@ -175,9 +192,9 @@ void refl_bwd_cpu(ReflBwdArgs a) {
     const TileRange r = a.bins.ranges[tile];
     for (int32_t k = r.begin; k < r.end && live > 0; ++k) {
       const int32_t g = a.bins.values[k];
-      const Splat& s = a.splats[g];
       TilePixels p;
-      if (!reach(s, tp, p)) continue;
+      if (!reach(bounds[size_t(g)], tp, p)) continue;
+      const Splat& s = a.splats[g];
       SplatGrad v{};
       for (int y = p.y0; y < p.y1; ++y)
         for (int x = p.x0; x < p.x1; ++x) {
