@@ -159,24 +159,41 @@ void Renderer::render(const RenderCamera& camera, const GaussianSet& base, const
                           out.D_b.view()};
     RRG_DISPATCH(device_, kernel::base_fwd_cpu(a), kernel::base_fwd_cuda(a));
   });
-  timings_.reflection_ms = timed(t, device_, [&] { reflection_forward(vr, out); });
+  timings_.reflection_ms = timed(t, device_, [&] { reflection_forward(vr, raycast.I, out); });
   timings_.composite_ms = timed(t, device_, [&] {
     RRG_DISPATCH(device_, kernel::composite_cpu(out.C_b.view(), raycast.R.view(), out.C_r.view(), out.C.view()),
                  kernel::composite_cuda(out.C_b.view(), raycast.R.view(), out.C_r.view(), out.C.view()));
   });
 }
 
-void Renderer::reflection_forward(const kernel::View& view, RenderOutputs& out) {
+void Renderer::render_reflection(const RenderCamera& camera, const GaussianSet& reflection,
+                                 const DeviceImage<int32_t>& I, RenderOutputs& out) {
+  const Intrinsics& K = camera.K;
+  if (!K.valid()) throw std::invalid_argument("Renderer: invalid intrinsics " + K.to_string());
+  if (reflection.device() != device_)
+    throw std::invalid_argument("Renderer: Gaussian sets must be on " + device_.to_string());
+  check_image(I, K, device_, "I");
+  base_set_ = nullptr;  // no backward() after this: its state is not a full render
+  refl_set_ = &reflection;
+  ensure_image(out.C_r, K.width, K.height, device_);
+  ensure_image(out.W_r, K.width, K.height, device_);
+  const kernel::View vr = make_view(camera, reflection);
+  timings_.reflection_ms = timed(params_.time_stages, device_, [&] {
+    project(vr, reflection, refl_);
+    reflection_forward(vr, I, out);
+  });
+}
+
+void Renderer::reflection_forward(const kernel::View& view, const DeviceImage<int32_t>& I, RenderOutputs& out) {
   const GaussianSet& set = *refl_set_;
   const int64_t n = int64_t(set.size());
   auto splats = first(refl_.splats, n);
   auto rects = first(refl_.rects, n);
-  const RaycastInputs& in = *raycast_;
   if (params_.variant != ReflectionVariant::MultiPass) {
     refl_.bins.build(view, splats, rects, set.plane_ids(), -1, true, device_);
     refl_entries_ = refl_.bins.entries();
     const auto mode = params_.variant == ReflectionVariant::Grouped ? kernel::PlaneMode::Match : kernel::PlaneMode::All;
-    kernel::ReflFwdArgs a{view, splats, refl_.bins.views(), set.plane_ids(), in.I.view(), mode, 0,
+    kernel::ReflFwdArgs a{view, splats, refl_.bins.views(), set.plane_ids(), I.view(), mode, 0,
                           out.C_r.view(), out.W_r.view()};
     RRG_DISPATCH(device_, kernel::refl_fwd_cpu(a), kernel::refl_fwd_cuda(a));
     return;
@@ -190,12 +207,12 @@ void Renderer::reflection_forward(const kernel::View& view, RenderOutputs& out) 
   for (int32_t k : reflection_groups()) {
     refl_.bins.build(view, splats, rects, set.plane_ids(), k, true, device_);
     refl_entries_ += refl_.bins.entries();
-    kernel::ReflFwdArgs a{view, splats, refl_.bins.views(), set.plane_ids(), in.I.view(), kernel::PlaneMode::All, k,
+    kernel::ReflFwdArgs a{view, splats, refl_.bins.views(), set.plane_ids(), I.view(), kernel::PlaneMode::All, k,
                           group_C_.view(), group_W_.view()};
     RRG_DISPATCH(device_, kernel::refl_fwd_cpu(a), kernel::refl_fwd_cuda(a));
     RRG_DISPATCH(device_,
-                 kernel::mask_group_cpu(in.I.view(), k, group_C_.view(), group_W_.view(), out.C_r.view(), out.W_r.view()),
-                 kernel::mask_group_cuda(in.I.view(), k, group_C_.view(), group_W_.view(), out.C_r.view(), out.W_r.view()));
+                 kernel::mask_group_cpu(I.view(), k, group_C_.view(), group_W_.view(), out.C_r.view(), out.W_r.view()),
+                 kernel::mask_group_cuda(I.view(), k, group_C_.view(), group_W_.view(), out.C_r.view(), out.W_r.view()));
   }
 }
 

@@ -33,6 +33,12 @@ class Renderer {
   void render(const RenderCamera& camera, const GaussianSet& base, const GaussianSet& reflection,
               const RaycastInputs& raycast, RenderOutputs& out);
 
+  // Pass 3 alone: C_r and W_r of `reflection` over the plane-id map I (the other outputs are left
+  // as they are). What the tracking mask needs, C_r at a pose, without pass 2 or the TSDF colour.
+  // backward() cannot follow it (it throws until the next render()).
+  void render_reflection(const RenderCamera& camera, const GaussianSet& reflection, const DeviceImage<int32_t>& I,
+                         RenderOutputs& out);
+
   // Gradients of every parameter of both sets (not the TSDF maps) for the last render(), given
   // dL/dC, dL/dD_b and optionally dL/dC_r. Overwrites v_base and v_reflection.
   void backward(const RenderUpstream& upstream, GaussianGrads& v_base, GaussianGrads& v_reflection);
@@ -51,7 +57,7 @@ class Renderer {
   };
   kernel::View make_view(const RenderCamera& camera, const GaussianSet& set) const;
   void project(const kernel::View& view, const GaussianSet& set, Projected& p);
-  void reflection_forward(const kernel::View& view, RenderOutputs& out);
+  void reflection_forward(const kernel::View& view, const DeviceImage<int32_t>& I, RenderOutputs& out);
   void reflection_backward(const kernel::View& view, const DeviceImage<Color>& v_C_r);
   std::vector<int32_t> reflection_groups() const;
 

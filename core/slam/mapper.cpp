@@ -332,6 +332,14 @@ void GaussianMapper::render(const RenderCamera& cam, const RaycastResult& raycas
   query_renderer_.render(cam, snap->base, snap->reflection, in, out);
 }
 
+ColorImage GaussianMapper::render_reflection(const RenderCamera& cam, const DeviceImage<int32_t>& I) const {
+  const auto snap = snapshot();
+  RenderOutputs out;
+  std::lock_guard lock(render_mutex_);
+  query_renderer_.render_reflection(cam, snap->reflection, I, out);
+  return out.C_r.to_host();
+}
+
 GaussianHost GaussianMapper::base_host() const { return snapshot()->base.to_host(); }
 GaussianHost GaussianMapper::reflection_host() const { return snapshot()->reflection.to_host(); }
 

@@ -131,6 +131,9 @@ class GaussianMapper {
   // Renders passes 2 and 3 of the latest snapshot at cam over a raycast at the same camera.
   // Thread-safe with step().
   void render(const RenderCamera& cam, const RaycastResult& raycast, RenderOutputs& out) const;
+  // C_r alone (pass 3 of the latest snapshot's reflection set over plane-id map I), on the host.
+  // Thread-safe with step().
+  ColorImage render_reflection(const RenderCamera& cam, const DeviceImage<int32_t>& I) const;
   GaussianHost base_host() const;
   GaussianHost reflection_host() const;
   // Replaces both sets (session load); optimiser state restarts. Publishes a snapshot.

@@ -129,19 +129,19 @@ const SessionConfig& Session::config() const { return impl_->config; }
 
 // --- helpers ----------------------------------------------------------------------------------------
 
-RaycastResult Session::Impl::locked_raycast(const Intrinsics& K_, const Eigen::Isometry3f& T_wc) const {
+RaycastResult Session::Impl::locked_raycast(const Intrinsics& K_, const Eigen::Isometry3f& T_wc,
+                                            RaycastOutputs outputs) const {
   const std::vector<int32_t> ids = remap_copy();
   std::lock_guard lock(volume_mutex);
-  return raycast(volume, K_, T_wc, ids);
+  return raycast(volume, K_, T_wc, ids, outputs);
 }
 
+// C_r at the ICP pose for the tracking mask (§4.1.2): pass 3 over the plane-id map only.
 ColorImage Session::Impl::render_reflection(const Eigen::Isometry3f& T_wc) {
   const auto snap = mapper.snapshot();
   if (!snap || snap->reflection.size() == 0) return ColorImage(K.width, K.height, Color::Zero());
-  const RaycastResult rc = locked_raycast(K, T_wc);
-  RenderOutputs out;
-  mapper.render(RenderCamera{K, T_wc}, rc, out);
-  return out.C_r.to_host();
+  const RaycastResult rc = locked_raycast(K, T_wc, RaycastOutputs{.color = false, .reflection = true});
+  return mapper.render_reflection(RenderCamera{K, T_wc}, rc.plane_ids);
 }
 
 MappingContext Session::Impl::mapping_context() {

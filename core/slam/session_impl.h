@@ -66,7 +66,8 @@ struct Session::Impl {
                 DeviceImage<int32_t>& plane_ids, DeviceImage<uint8_t>& mask);
   void schedule_mapping(FrameReport& report);
   MappingContext mapping_context();
-  RaycastResult locked_raycast(const Intrinsics& K, const Eigen::Isometry3f& T_wc) const;
+  RaycastResult locked_raycast(const Intrinsics& K, const Eigen::Isometry3f& T_wc,
+                               RaycastOutputs outputs = RaycastOutputs::all()) const;
   ColorImage render_reflection(const Eigen::Isometry3f& T_wc);  // C_r for the tracking mask
   std::vector<int32_t> remap_copy() const {
     std::lock_guard lock(state_mutex);
