@@ -17,8 +17,10 @@ cd "$(dirname "$0")/.."
 
 scripts/install_deps.sh
 BUILD_DIR=${BUILD_DIR:-build}
-cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release -DRRG_BUILD_TESTS=OFF \
-  -DRRG_BUILD_BENCH=OFF -DCMAKE_CUDA_ARCHITECTURES="${RRG_CUDA_ARCH:-90}" >/dev/null
+# Configured as scripts/test.sh configures it (tests and benchmarks on, the project's defaults), so
+# that the two scripts share build/ without flipping each other's options; only `rrg` is built here.
+cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release -DRRG_BUILD_TESTS=ON \
+  -DRRG_BUILD_BENCH=ON -DCMAKE_CUDA_ARCHITECTURES="${RRG_CUDA_ARCH:-90}" >/dev/null
 cmake --build "$BUILD_DIR" -j "${JOBS:-2}" --target rrg
 RRG="$BUILD_DIR/bin/rrg"
 OUT=${OUT_DIR:-out}
