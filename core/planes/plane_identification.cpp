@@ -182,9 +182,13 @@ IdentificationResult PlaneIdentifier::identify(const IdentificationFrame& frame,
     v.variance_mean = s.pixels > 0 ? float(s.variance_sum / double(s.pixels)) : 0.0f;
     v.reflective_now = v.candidate && v.variance_fraction > params_.area_threshold;
     v.accepted = vote_.record(id, window, v.reflective_now);
+    // The predicted reflection mask of a confirmed plane: its reflective semantic mask; with a cue
+    // that makes every plane a candidate (`none`), the plane's own pixels. A confirmed plane on
+    // which the cue finds no reflective mask in this frame predicts nothing: its fallback mask is
+    // a non-reflective category (a "wall" mask covers every wall in view), never a reflection.
     if (v.accepted) {
-      if (m >= 0 && !cue_->every_plane_is_candidate()) confirmed_masks.push_back(m);
-      else confirmed_planes.push_back(id);
+      if (cue_->every_plane_is_candidate()) confirmed_planes.push_back(id);
+      else if (reflective_mask) confirmed_masks.push_back(m);
     }
     out.planes.push_back(v);
   }

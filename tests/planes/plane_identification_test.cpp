@@ -146,6 +146,18 @@ TEST(PlaneIdentification, MirrorOnAWallMakesTheWallPlaneACandidate) {
   for (size_t i = 0; i < s.labels.size(); ++i)  // floor (also accepted) and mirror, never the bare wall
     ASSERT_EQ(r.reflection_mask[i], (s.labels[i] == 1 || s.labels[i] == 3) ? 1 : 0) << i;
 
+  // A later frame in which the cue finds no mirror on the accepted wall plane: the plane stays in
+  // L_ref, but its only mask there is the non-reflective "wall" category (every wall in view), which
+  // must not become a predicted reflection.
+  Scene hidden = s;
+  for (size_t i = 0; i < hidden.labels.size(); ++i)
+    if (hidden.labels[i] == 3) hidden.labels[i] = 2;
+  r = run(id, hidden, 1);
+  EXPECT_TRUE(verdict_for_label(r, hidden, 2).accepted);
+  EXPECT_EQ(verdict_for_label(r, hidden, 2).label, "wall");
+  for (size_t i = 0; i < hidden.labels.size(); ++i)  // the floor's mask only
+    ASSERT_EQ(r.reflection_mask[i], hidden.labels[i] == 1 ? 1 : 0) << i;
+
   // With the paper's prompts (no "mirror") the wall plane is not a candidate.
   PlaneIdentifier paper({}, make_label_semantics(t, paper_prompts()));
   r = run(paper, s, 4);
