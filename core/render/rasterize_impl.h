@@ -1,7 +1,9 @@
 #pragma once
 // Per-pixel loops of pass 2 and pass 3 (forward and backward) and the composite, templated on the
-// back end; instantiated by rasterize_cpu.cpp and rasterize_cuda.cu. Pixels run in tile-major order
-// (blend_device.h: tile_pixel) so neighbouring work items walk the same tile list.
+// back end. rasterize_cuda.cu instantiates all of them; the CPU back end (rasterize_cpu.cpp) runs
+// the same per-pixel maths tile by tile, splat-major, and takes only the composite and the group
+// mask from here (the tests run these loops on the CPU as its reference). Pixels run in tile-major
+// order (blend_device.h: tile_pixel) so neighbouring work items walk the same tile list.
 #include "core/common/atomics.h"
 #include "core/common/parallel_for.h"
 #include "core/render/blend_device.h"
