@@ -49,6 +49,19 @@ bool reach(const TilePixels& splat, const TilePixels& t, TilePixels& out) {
   return out.x0 < out.x1 && out.y0 < out.y1;
 }
 
+// f(g, splat, pixels) for every splat of the tile's list, in list order, that reaches the tile;
+// pixels is the part of the tile within its reach. Stops early when more() turns false.
+template <class More, class F>
+void for_each_reaching_splat(const BinViews& bins, Span<const Splat> splats, const std::vector<TilePixels>& bounds,
+                             int tile, const TilePixels& tp, More more, F f) {
+  const TileRange r = bins.ranges[tile];
+  for (int32_t k = r.begin; k < r.end && more(); ++k) {
+    const int32_t g = bins.values[k];
+    TilePixels p;
+    if (reach(bounds[size_t(g)], tp, p)) f(g, splats[g], p);
+  }
+}
+
 // f(tile) for every tile on OpenMP threads; tiles differ in work, so they are handed out one by one.
 template <class F>
 void for_each_tile(const View& v, F f) {
@@ -67,18 +80,14 @@ void base_fwd_cpu(BaseFwdArgs a) {
     float D_t[kTilePixels];
     for (int y = tp.y0; y < tp.y1; ++y)
       for (int x = tp.x0; x < tp.x1; ++x) D_t[tp.local(x, y)] = a.D_t(x, y);
-    const TileRange r = a.bins.ranges[tile];
-    for (int32_t k = r.begin; k < r.end; ++k) {
-      const int32_t g = a.bins.values[k];
-      TilePixels p;
-      if (!reach(bounds[size_t(g)], tp, p)) continue;
-      const Splat& s = a.splats[g];
-      for (int y = p.y0; y < p.y1; ++y)
-        for (int x = p.x0; x < p.x1; ++x) {
-          const int l = tp.local(x, y);
-          base_accumulate(acc[l], s, float(x), float(y), D_t[l], a.eps);
-        }
-    }
+    for_each_reaching_splat(a.bins, a.splats, bounds, tile, tp, [] { return true; },
+                            [&](int32_t, const Splat& s, const TilePixels& p) {
+        for (int y = p.y0; y < p.y1; ++y)
+          for (int x = p.x0; x < p.x1; ++x) {
+            const int l = tp.local(x, y);
+            base_accumulate(acc[l], s, float(x), float(y), D_t[l], a.eps);
+          }
+                            });
     for (int y = tp.y0; y < tp.y1; ++y)
       for (int x = tp.x0; x < tp.x1; ++x) {
         const int l = tp.local(x, y);
@@ -113,20 +122,16 @@ void base_bwd_cpu(BaseBwdArgs a) {
         up[l] = base_resolve_bwd(a.W_g(x, y), D_t[l], Vec3<float>(a.C_b(x, y)), a.D_b(x, y), v_C_b, v_D_b);
       }
     if (!any) return;
-    const TileRange r = a.bins.ranges[tile];
-    for (int32_t k = r.begin; k < r.end; ++k) {
-      const int32_t g = a.bins.values[k];
-      TilePixels p;
-      if (!reach(bounds[size_t(g)], tp, p)) continue;
-      const Splat& s = a.splats[g];
-      SplatGrad v{};
-      for (int y = p.y0; y < p.y1; ++y)
-        for (int x = p.x0; x < p.x1; ++x) {
-          const int l = tp.local(x, y);
-          if (active[l]) base_splat_bwd(s, float(x), float(y), D_t[l], a.eps, up[l], v);
-        }
-      if (!is_zero(v)) accumulate_grad(CpuBackend{}, &a.v_splats[g], v);
-    }
+    for_each_reaching_splat(a.bins, a.splats, bounds, tile, tp, [] { return true; },
+                            [&](int32_t g, const Splat& s, const TilePixels& p) {
+        SplatGrad v{};
+        for (int y = p.y0; y < p.y1; ++y)
+          for (int x = p.x0; x < p.x1; ++x) {
+            const int l = tp.local(x, y);
+            if (active[l]) base_splat_bwd(s, float(x), float(y), D_t[l], a.eps, up[l], v);
+          }
+        if (!is_zero(v)) accumulate_grad(CpuBackend{}, &a.v_splats[g], v);
+                            });
   });
 }
 
@@ -145,19 +150,15 @@ void refl_fwd_cpu(ReflFwdArgs a) {
         alive[l] = refl_pixel_active(a.mode, a.plane, I[l]);
         live += alive[l] ? 1 : 0;
       }
-    const TileRange r = a.bins.ranges[tile];
-    for (int32_t k = r.begin; k < r.end && live > 0; ++k) {
-      const int32_t g = a.bins.values[k];
-      TilePixels p;
-      if (!reach(bounds[size_t(g)], tp, p)) continue;
-      const Splat& s = a.splats[g];
-      for (int y = p.y0; y < p.y1; ++y)
-        for (int x = p.x0; x < p.x1; ++x) {
-          const int l = tp.local(x, y);
-          if (!alive[l] || (a.mode == PlaneMode::Match && a.plane_ids[g] != I[l])) continue;  // 1(l_i == I(u))
-          if (!refl_step(st[l], s, float(x), float(y))) alive[l] = false, --live;           // early termination
-        }
-    }
+    for_each_reaching_splat(a.bins, a.splats, bounds, tile, tp, [&] { return live > 0; },
+                            [&](int32_t g, const Splat& s, const TilePixels& p) {
+        for (int y = p.y0; y < p.y1; ++y)
+          for (int x = p.x0; x < p.x1; ++x) {
+            const int l = tp.local(x, y);
+            if (!alive[l] || (a.mode == PlaneMode::Match && a.plane_ids[g] != I[l])) continue;  // 1(l_i == I(u))
+            if (!refl_step(st[l], s, float(x), float(y))) alive[l] = false, --live;           // early termination
+          }
+                            });
     for (int y = tp.y0; y < tp.y1; ++y)
       for (int x = tp.x0; x < tp.x1; ++x) {
         const int l = tp.local(x, y);
@@ -189,22 +190,18 @@ void refl_bwd_cpu(ReflBwdArgs a) {
         alive[l] = true;
         ++live;
       }
-    const TileRange r = a.bins.ranges[tile];
-    for (int32_t k = r.begin; k < r.end && live > 0; ++k) {
-      const int32_t g = a.bins.values[k];
-      TilePixels p;
-      if (!reach(bounds[size_t(g)], tp, p)) continue;
-      const Splat& s = a.splats[g];
-      SplatGrad v{};
-      for (int y = p.y0; y < p.y1; ++y)
-        for (int x = p.x0; x < p.x1; ++x) {
-          const int l = tp.local(x, y);
-          if (!alive[l] || (a.mode == PlaneMode::Match && a.plane_ids[g] != I[l])) continue;
-          if (!refl_step_bwd(st[l], s, float(x), float(y), C_final[l], W_final[l], v_C[l], 0.0f, v))
-            alive[l] = false, --live;
-        }
-      if (!is_zero(v)) accumulate_grad(CpuBackend{}, &a.v_splats[g], v);
-    }
+    for_each_reaching_splat(a.bins, a.splats, bounds, tile, tp, [&] { return live > 0; },
+                            [&](int32_t g, const Splat& s, const TilePixels& p) {
+        SplatGrad v{};
+        for (int y = p.y0; y < p.y1; ++y)
+          for (int x = p.x0; x < p.x1; ++x) {
+            const int l = tp.local(x, y);
+            if (!alive[l] || (a.mode == PlaneMode::Match && a.plane_ids[g] != I[l])) continue;
+            if (!refl_step_bwd(st[l], s, float(x), float(y), C_final[l], W_final[l], v_C[l], 0.0f, v))
+              alive[l] = false, --live;
+          }
+        if (!is_zero(v)) accumulate_grad(CpuBackend{}, &a.v_splats[g], v);
+                            });
   });
 }
 
