@@ -139,6 +139,8 @@ void run_eval(const EvalOptions& o) {
                                         {"gt", r.segmentation.gt}, {"detected", r.segmentation.detected}}},
                       {"id_stability", {{"planes", r.ids.planes}, {"stable", r.ids.stable}, {"frame_fraction", r.ids.fraction()}}},
                       {"fuse_ms", r.fuse_ms}, {"raycast_ms", r.raycast_ms}, {"cues", nlohmann::json::array()}};
+  for (const auto& [g, h] : r.ids.unstable)
+    for (const auto& [id, n] : h) j["id_stability"]["unstable"][std::to_string(g)][std::to_string(id)] = n;
   for (const auto& c : r.cues)
     j["cues"].push_back({{"semantics", c.semantics}, {"precision", c.reflective.precision()}, {"recall", c.reflective.recall()},
                          {"accepted", c.reflective.accepted}, {"accepted_correct", c.reflective.accepted_correct},
@@ -158,6 +160,15 @@ void run_eval(const EvalOptions& o) {
               (long long)r.segmentation.detected, r.segmentation.precision_iou(), r.segmentation.recall_iou());
   std::printf("global ids: %d/%d GT planes keep one id in >= 95%% of their frames; %.3f of (plane, frame) pairs\n",
               r.ids.stable, r.ids.planes, r.ids.fraction());
+  for (const auto& [g, h] : r.ids.unstable) {
+    std::string ids;
+    for (const auto& [id, n] : h) {
+      const auto m = r.ids.majority_gt.find(id);
+      ids += " " + std::to_string(id) + ":" + std::to_string(n) +
+             (m != r.ids.majority_gt.end() ? " (mostly GT " + std::to_string(m->second) + ")" : "");
+    }
+    std::printf("  unstable GT plane %d: global id:frames%s\n", g, ids.c_str());
+  }
   for (const auto& c : r.cues) {
     std::printf("semantics %-7s reflective planes: precision %.3f (%d/%d) recall %.3f (%d/%d), mask IoU %.3f\n",
                 c.semantics.c_str(), c.reflective.precision(), c.reflective.accepted_correct, c.reflective.accepted,

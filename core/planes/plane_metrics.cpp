@@ -167,8 +167,20 @@ IdStability IdentificationScorer::id_stability(const std::vector<int32_t>& remap
     ++s.planes;
     s.frames += total;
     s.consistent += mode;
-    if (double(mode) >= 0.95 * double(total)) ++s.stable;
+    if (double(mode) >= 0.95 * double(total))
+      ++s.stable;
+    else
+      s.unstable[g] = h;
   }
+  std::map<int, std::map<int, int64_t>> by_global;  // canonical global id -> GT id -> pixels
+  for (const auto& [key, n] : pixels_) by_global[canon(key.first)][key.second] += n;
+  for (const auto& [g, h] : s.unstable)
+    for (const auto& [id, n] : h) {
+      const auto it = by_global.find(id);
+      if (it == by_global.end()) continue;
+      s.majority_gt[id] = std::max_element(it->second.begin(), it->second.end(),
+                                           [](const auto& a, const auto& b) { return a.second < b.second; })->first;
+    }
   return s;
 }
 
