@@ -1,6 +1,9 @@
 // rrg run: the whole RRG-SLAM pipeline (core/slam Session) on a dataset, with evaluation
 // (core/slam/runner.h). --ablate-reflections runs the same frames a second time with base
 // Gaussians only and prints both side by side (the paper's reflection ablation, in one run).
+// The first Ctrl-C (or SIGTERM) stops the run after the current frame and still writes every output
+// over the frames processed (metrics.json "interrupted": true, exit code 128 + the signal: 130 for
+// Ctrl-C); a second one aborts.
 #include "client/commands/command.h"
 #include "core/common/device.h"
 #include "core/io/atomic_file.h"
@@ -9,7 +12,12 @@
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
+#include <unistd.h>
+
+#include <atomic>
+#include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <memory>
 #include <sstream>
@@ -26,6 +34,36 @@ struct RunCliOptions {
   std::vector<size_t> decomposition;
   size_t max_frames = 0, train_stride = 10;
   bool no_reflections = false, gt_poses = false, sync = false, ablate = false, no_progress = false;
+};
+
+// SIGINT / SIGTERM -> a stop request for RunOptions::stop while a run is in progress; the handlers
+// before it are restored when it ends. The handler only sets the flag, writes one line and puts the
+// default action back, so a second signal ends the process at once.
+std::atomic<int> g_stop_signal{0};
+
+extern "C" void request_stop(int sig) {
+  g_stop_signal.store(sig);
+  constexpr char kMsg[] = "\nrrg run: stopping after this frame and writing the outputs; press Ctrl-C again to abort\n";
+  [[maybe_unused]] const ssize_t n = write(STDERR_FILENO, kMsg, sizeof(kMsg) - 1);
+  std::signal(sig, SIG_DFL);
+}
+
+class StopOnSignal {
+ public:
+  StopOnSignal() : old_int_(std::signal(SIGINT, request_stop)), old_term_(std::signal(SIGTERM, request_stop)) {
+    g_stop_signal.store(0);
+  }
+  ~StopOnSignal() {
+    std::signal(SIGINT, old_int_);
+    std::signal(SIGTERM, old_term_);
+  }
+  StopOnSignal(const StopOnSignal&) = delete;
+  StopOnSignal& operator=(const StopOnSignal&) = delete;
+  int signal() const { return g_stop_signal.load(); }  // 0 while none arrived
+
+ private:
+  void (*old_int_)(int);
+  void (*old_term_)(int);
 };
 
 std::string opt_cm(const std::optional<double>& v) { return v ? fmt::format("{:.2f}", *v) : std::string("-"); }
@@ -71,11 +109,15 @@ void run(const RunCliOptions& o) {
   ro.decomposition_frames = o.decomposition;
   ro.render_poses = o.render_poses;
   ro.progress = !o.no_progress;
+  StopOnSignal signals;
+  ro.stop = [&signals] { return signals.signal() != 0; };
 
   std::vector<std::pair<std::string, RunResult>> runs;
   runs.emplace_back(c.mapping.reflections ? "reflections" : "no-reflections", run_dataset(ro));
   print_timings(runs.back().second.timings, c.device.to_string());
-  if (o.ablate && c.mapping.reflections) {
+  const bool interrupted = runs.back().second.metrics.interrupted;
+  if (interrupted && o.ablate) spdlog::warn("run: interrupted, so the --no-reflections run of the ablation is skipped");
+  if (o.ablate && c.mapping.reflections && !interrupted) {
     RunOptions base = ro;
     base.config.mapping.reflections = false;
     base.out = o.out.empty() ? std::filesystem::path() : std::filesystem::path(o.out) / "no_reflections";
@@ -101,6 +143,11 @@ void run(const RunCliOptions& o) {
       });
   }
   if (!o.out.empty()) std::printf("outputs -> %s (trajectory.txt, mesh.ply/.drc, gaussians_*.ply/.spz, renders/, metrics.json, timings.json)\n", o.out.c_str());
+  if (runs.back().second.metrics.interrupted) {
+    std::printf("interrupted after %zu frames; the outputs above cover those frames\n", runs.back().second.metrics.frames);
+    std::fflush(stdout);
+    std::exit(128 + (signals.signal() != 0 ? signals.signal() : SIGINT));  // the shell's code for a job ended by it
+  }
 }
 
 }  // namespace

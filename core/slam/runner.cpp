@@ -156,8 +156,11 @@ RunResult run_dataset(const RunOptions& o) {
   config.semantics = choose_semantics(o, *dataset, config);
   if (config.gt_poses && !dataset->has_ground_truth())
     throw std::invalid_argument("run: --gt-poses needs a dataset with ground-truth poses");
-  const size_t n = o.max_frames > 0 ? std::min(dataset->size(), o.max_frames) : dataset->size();
+  size_t n = o.max_frames > 0 ? std::min(dataset->size(), o.max_frames) : dataset->size();
   if (n == 0) throw std::invalid_argument("run: " + o.dataset.string() + " has no frames");
+  for (size_t i : o.decomposition_frames)  // before the run, not after an hour of it
+    if (i >= n) throw std::invalid_argument("run: --decomposition frame " + std::to_string(i) + " is beyond the run (" +
+                                            std::to_string(n) + " frames)");
   if (!o.out.empty()) std::filesystem::create_directories(o.out);
   if (!o.out.empty())
     io::write_atomically(o.out / "config.yaml", [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << config_to_yaml(config); });
@@ -191,6 +194,11 @@ RunResult run_dataset(const RunOptions& o) {
     const SessionStatus st = session.status();
     bar.update(i + 1, fmt::format("{} G_b {} G_r {} planes", st.mapping.base_gaussians, st.mapping.reflection_gaussians,
                                   st.reflective_planes.size()));
+    if (i + 1 < n && o.stop && o.stop()) {
+      spdlog::warn("run: stopped after frame {} of {}; finishing with the frames processed", i + 1, n);
+      n = i + 1;
+      result.metrics.interrupted = true;
+    }
   }
   session.finish();
   const double wall_ms = ms_since(wall0);
@@ -224,7 +232,9 @@ RunResult run_dataset(const RunOptions& o) {
   m.reflection_gaussians = st.mapping.reflection_gaussians;
   m.reflective_planes = int64_t(st.reflective_planes.size());
   result.trajectory = session.trajectory();
-  if (dataset->has_ground_truth()) {
+  if (dataset->has_ground_truth() && result.trajectory.size() < 3) {
+    spdlog::warn("run: no ATE: {} pose(s), the alignment needs at least 3", result.trajectory.size());
+  } else if (dataset->has_ground_truth()) {
     io::Trajectory gt = dataset->ground_truth();
     if (gt.size() > n) gt.resize(n);
     m.ate_rmse_cm = eval::evaluate_trajectory(result.trajectory, gt).ate.rmse_cm;
@@ -238,7 +248,10 @@ RunResult run_dataset(const RunOptions& o) {
   }
   m.train = train.scores();
   for (size_t i : o.decomposition_frames) {
-    if (i >= n) throw std::invalid_argument("run: --decomposition frame " + std::to_string(i) + " is beyond the run");
+    if (i >= n) {
+      spdlog::warn("run: --decomposition frame {} was not reached (stopped after {} frames)", i, n);
+      continue;
+    }
     const io::Frame f = dataset->load(i);
     outputs.decomposition(i, session.render(config.K, reports[i].T_wc), f.color);
   }
@@ -302,6 +315,7 @@ RunResult run_dataset(const RunOptions& o) {
 std::string metrics_json(const RunMetrics& m) {
   nlohmann::ordered_json j;
   j["frames"] = m.frames;
+  j["interrupted"] = m.interrupted;
   j["lost"] = m.lost;
   if (m.ate_rmse_cm) j["ate_rmse_cm"] = *m.ate_rmse_cm;
   j["ate_alignment"] = "rigid SE(3) Umeyama, no scale";

@@ -28,6 +28,10 @@ struct RunOptions {
   std::filesystem::path render_poses;        // file of poses to render at the end
   bool write_gaussians = true, write_mesh = true, write_renders = true;
   bool progress = true;                      // progress bar with live FPS on stderr
+  // Asked after every frame (e.g. "was Ctrl-C pressed?"); when it returns true the run stops there
+  // and finishes as if the dataset ended: every output and metric over the frames processed, and
+  // RunMetrics::interrupted set.
+  std::function<bool()> stop;
 };
 
 // One named pose to render: "name tx ty tz qx qy qz qw", or a TUM line (the name is then the
@@ -46,7 +50,8 @@ struct ImageScores {
 };
 
 struct RunMetrics {
-  size_t frames = 0, lost = 0;
+  size_t frames = 0, lost = 0;                // frames processed (fewer than asked for when interrupted)
+  bool interrupted = false;                   // RunOptions::stop ended the run early
   std::optional<double> ate_rmse_cm;          // rigid SE(3) Umeyama alignment
   ImageScores train, held_out;                // held_out only with a novel/ folder (synth)
   // With a ground-truth mesh: accuracy; completion and its ratio (< 3 cm) over the part of the

@@ -5,8 +5,18 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+extern char** environ;
 
 namespace rrg {
 namespace {
@@ -38,6 +48,46 @@ TEST(RunCli, WritesOutputsAndScoresGeometryOnTheObservedSurface) {
   EXPECT_LT(comp, 3.0) << j.dump(2);
   EXPECT_LT(g.at("accuracy_cm").get<double>(), 3.0) << j.dump(2);
   EXPECT_GT(g.at("completion_ratio_3cm").get<double>(), 0.8) << j.dump(2);
+}
+
+// Ctrl-C during a run: the run stops after the current frame and still writes every output over
+// the frames it processed, says so in metrics.json, and exits with 128 + SIGINT.
+TEST(RunCli, InterruptStopsAfterTheCurrentFrameAndWritesTheOutputs) {
+  test::TempDir dir("run_cli_interrupt");
+  const auto seq = dir / "seq";
+  auto r = test::run_rrg("synth --preset living_room --frames 30 --width 160 --height 120 --novel 0 --out " + seq.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto out = dir / "run";
+  std::vector<std::string> args = {RRG_CLI,       "run",     "--dataset", seq.string(), "--out", out.string(),
+                                   "--device",    "cpu",     "--sync",    "--no-progress",
+                                   "--set",       "tsdf.voxel_size=0.02", "--set", "tsdf.truncation=0.08"};
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  ASSERT_EQ(posix_spawn(&pid, RRG_CLI, nullptr, nullptr, argv.data(), environ), 0);
+  // config.yaml is written once the run has started (the signal handler is installed before it).
+  for (int i = 0; i < 600 && !std::filesystem::exists(out / "config.yaml"); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  ASSERT_TRUE(std::filesystem::exists(out / "config.yaml"));
+  ASSERT_EQ(kill(pid, SIGINT), 0);
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+  EXPECT_EQ(WEXITSTATUS(status), 128 + SIGINT);
+
+  const auto j = nlohmann::json::parse(std::ifstream(out / "metrics.json"));
+  EXPECT_TRUE(j.at("interrupted").get<bool>());
+  const size_t frames = j.at("frames").get<size_t>();
+  EXPECT_GE(frames, 1u);
+  EXPECT_LT(frames, 30u);
+  EXPECT_EQ(j.contains("ate_rmse_cm"), frames >= 3);  // over the frames processed; the alignment needs 3
+  std::ifstream traj(out / "trajectory.txt");
+  size_t poses = 0;
+  for (std::string line; std::getline(traj, line);)
+    if (!line.empty() && line[0] != '#') ++poses;
+  EXPECT_EQ(poses, frames);
+  for (const char* f : {"mesh.ply", "timings.json", "gaussians_base.ply"}) EXPECT_TRUE(std::filesystem::exists(out / f)) << f;
 }
 
 }  // namespace
