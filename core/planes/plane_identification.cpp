@@ -7,6 +7,7 @@
 #include <cmath>
 #include <map>
 #include <stdexcept>
+#include <utility>
 
 namespace rrg {
 
@@ -49,6 +50,25 @@ MaskImage interior(const Image<T>& map, const DepthImage& depth, const Intrinsic
       inner(x, y) = k(x, y) >= r ? 1 : 0;
     }
   return inner;
+}
+
+// `map` with the pixels on a colour edge set to 0: a 4-neighbour in the same region whose
+// intensity x = (r + g + b) / 3 differs by more than `step`.
+Image<int32_t> without_color_edges(const Image<int32_t>& map, const ColorImage& color, float step) {
+  const int w = map.width(), h = map.height();
+  Image<int32_t> out = map;
+  auto x_of = [&](int u, int v) { return color(u, v).sum() / 3.0f; };
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u) {
+      const int id = map(u, v);
+      if (id == 0) continue;
+      const float x = x_of(u, v);
+      for (const auto [du, dv] : {std::pair{1, 0}, std::pair{0, 1}}) {
+        const int u2 = u + du, v2 = v + dv;
+        if (u2 < w && v2 < h && map(u2, v2) == id && std::abs(x_of(u2, v2) - x) > step) out(u, v) = out(u2, v2) = 0;
+      }
+    }
+  return out;
 }
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
@@ -113,7 +133,11 @@ IdentificationResult PlaneIdentifier::identify(const IdentificationFrame& frame,
   // Interiors: of the planes, and of the reflective masks (a colour edge at a mask's border
   // aliases into C_var the same way a plane border does).
   const float border_m = params_.variance_border_voxels * std::max(frame.voxel_size, 0.0f);
-  const MaskImage plane_inner = interior(out.global_map, depth, frame.K, border_m);
+  const MaskImage plane_inner =
+      params_.variance_skip_color_edges
+          ? interior(without_color_edges(out.global_map, *frame.color, 2.0f * std::sqrt(params_.variance_threshold)), depth,
+                     frame.K, border_m)
+          : interior(out.global_map, depth, frame.K, border_m);
   std::vector<MaskImage> mask_inner(masks.size());
   for (size_t m = 0; m < masks.size(); ++m)
     if (masks[m].reflective) mask_inner[m] = interior(masks[m].mask, depth, frame.K, border_m);

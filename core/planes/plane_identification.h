@@ -38,6 +38,13 @@ struct IdentificationParams {
   // across a border, so a thin matte plane beside a mirror (its frame) would otherwise inherit the
   // mirror's variance, and a colour edge (a whiteboard's rim on a wall) aliases into variance.
   float variance_border_voxels = 2.0f;
+  // Colour edges are borders too: where the input colour C_k steps by more than 2√δ_v in intensity
+  // between neighbouring pixels of one plane, the pixels within the same radius are left out. A
+  // voxel whose observations fall on either side of such a step (pixel quantisation, pose error,
+  // colour-depth misregistration, texture finer than a voxel) reaches a variance of step² / 4 > δ_v
+  // with nothing reflected: marker strokes on a whiteboard, book spines, printed texture. A
+  // reflection moves with the view, so its variance is not confined to the current frame's edges.
+  bool variance_skip_color_edges = true;
   void validate() const;             // throws std::invalid_argument
 };
 

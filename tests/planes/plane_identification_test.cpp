@@ -210,5 +210,42 @@ TEST(PlaneIdentification, VarianceBleedingAcrossAPlaneBorderIsIgnored) {
   EXPECT_FALSE(eroded.reflective_now);
 }
 
+// Texture aliases into C_var at colour edges: here the wall carries dark 2-pixel stripes every 16
+// pixels in the input colour C_k (a step of 0.8 in intensity), and C_var is high on the stripes and
+// the pixel on each side of them (4 / 16 = 25 % of the wall). With colour edges left out (the
+// default), none of those pixels is counted and the wall is not reflective; with them kept it is.
+// The same variance under a uniform input (a reflection's variance is not tied to the current
+// frame's edges) still counts.
+TEST(PlaneIdentification, VarianceAtColourEdgesOfTheInputIsIgnored) {
+  Scene s = make_scene();
+  ColorImage striped = s.color;
+  for (int v = 0; v < 240; ++v)
+    for (int u = 0; u < 320; ++u) {
+      if (s.labels(u, v) != 2) continue;
+      striped(u, v) = (u % 16 == 5 || u % 16 == 6) ? Color(0.1f, 0.1f, 0.1f) : Color(0.9f, 0.9f, 0.9f);
+      s.cvar(u, v) = (u % 16 >= 4 && u % 16 <= 7) ? 0.05f : 0.0f;
+    }
+  auto wall = [&](bool skip_edges, const ColorImage& color) {
+    IdentificationParams p;
+    p.variance_skip_color_edges = skip_edges;
+    PlaneIdentifier id(p, make_no_semantics());
+    IdentificationFrame f{&s.depth, &color, &s.labels, s.K, Eigen::Isometry3f::Identity(), 0, 0.02f};
+    return verdict_for_label(id.identify(f, s.cvar), s, 2);
+  };
+  const PlaneVerdict skipped = wall(true, striped), kept = wall(false, striped);
+  EXPECT_GT(kept.variance_fraction, 0.15f);
+  EXPECT_TRUE(kept.reflective_now);
+  EXPECT_LT(skipped.variance_fraction, 0.01f);
+  EXPECT_FALSE(skipped.reflective_now);
+  const PlaneVerdict uniform = wall(true, s.color);
+  EXPECT_GT(uniform.variance_fraction, 0.15f);
+  EXPECT_TRUE(uniform.reflective_now);
+  // A step below 2√δ_v = 0.2 is not an edge: 0.45 / 0.6 stripes leave the wall reflective.
+  for (int v = 0; v < 240; ++v)
+    for (int u = 0; u < 320; ++u)
+      if (s.labels(u, v) == 2) striped(u, v) = Color::Constant((u % 16 == 5 || u % 16 == 6) ? 0.45f : 0.6f);
+  EXPECT_TRUE(wall(true, striped).reflective_now);
+}
+
 }  // namespace
 }  // namespace rrg
