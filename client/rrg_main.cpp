@@ -32,6 +32,8 @@ int main(int argc, char** argv) {
 
   try {
     app.parse(argc, argv);
+  } catch (const rrg::cli::ExitWith& e) {
+    return e.code;
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);  // prints help / version / the usage error
     return code == 0 ? 0 : rrg::cli::kExitUsage;

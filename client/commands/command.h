@@ -9,6 +9,12 @@ namespace rrg::cli {
 inline constexpr int kExitFailure = 1;
 inline constexpr int kExitUsage = 2;
 
+// Thrown by a command that finished its work but must end with a given exit code (e.g. `rrg run`
+// stopped by a signal: 128 + the signal, after writing its outputs); rrg_main returns the code.
+struct ExitWith {
+  int code;
+};
+
 void register_synth_command(CLI::App& app);    // rrg synth
 void register_eval_command(CLI::App& app);     // rrg eval ate|images|mesh
 void register_dataset_command(CLI::App& app);  // rrg dataset info

@@ -17,7 +17,6 @@
 #include <atomic>
 #include <csignal>
 #include <cstdio>
-#include <cstdlib>
 #include <fstream>
 #include <memory>
 #include <sstream>
@@ -40,6 +39,7 @@ struct RunCliOptions {
 // before it are restored when it ends. The handler only sets the flag, writes one line and puts the
 // default action back, so a second signal ends the process at once.
 std::atomic<int> g_stop_signal{0};
+static_assert(std::atomic<int>::is_always_lock_free, "the signal handler needs a lock-free flag");
 
 extern "C" void request_stop(int sig) {
   g_stop_signal.store(sig);
@@ -125,8 +125,10 @@ void run(const RunCliOptions& o) {
     runs.emplace_back("no-reflections", run_dataset(base));
     print_timings(runs.back().second.timings, c.device.to_string());
   }
+  const bool second_interrupted = runs.size() == 2 && runs[1].second.metrics.interrupted;
+  if (second_interrupted) spdlog::warn("run: the --no-reflections run was interrupted; no comparison is written");
   print_table(runs);
-  if (runs.size() == 2) {
+  if (runs.size() == 2 && !second_interrupted) {
     const RunMetrics &a = runs[0].second.metrics, &b = runs[1].second.metrics;
     std::printf("reflections - no-reflections: novel reflective %+.2f dB, novel %+.2f dB, train reflective %+.2f dB, ATE %+.3f cm\n",
                 a.held_out.psnr_reflective - b.held_out.psnr_reflective, a.held_out.psnr - b.held_out.psnr,
@@ -145,8 +147,7 @@ void run(const RunCliOptions& o) {
   if (!o.out.empty()) std::printf("outputs -> %s (trajectory.txt, mesh.ply/.drc, gaussians_*.ply/.spz, renders/, metrics.json, timings.json)\n", o.out.c_str());
   if (runs.back().second.metrics.interrupted) {
     std::printf("interrupted after %zu frames; the outputs above cover those frames\n", runs.back().second.metrics.frames);
-    std::fflush(stdout);
-    std::exit(128 + (signals.signal() != 0 ? signals.signal() : SIGINT));  // the shell's code for a job ended by it
+    throw ExitWith{128 + (signals.signal() != 0 ? signals.signal() : SIGINT)};  // the shell's code for a job ended by it
   }
 }
 
