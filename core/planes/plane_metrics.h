@@ -57,7 +57,7 @@ std::map<int, int> group_coplanar_touching(const LabelImage& gt, const std::map<
 struct IdStability {
   int planes = 0, stable = 0;        // GT planes seen; those with one id in >= 95% of their frames
   int64_t frames = 0, consistent = 0;  // (plane, frame) pairs; those with the plane's modal id
-  // GT planes below 95 %: GT id -> canonical global id -> frames (the first entry is not the mode).
+  // GT planes below 95 %: GT id -> canonical global id -> frames with that id (ordered by id).
   std::map<int, std::map<int, int>> unstable;
   std::map<int, int> majority_gt;  // canonical global id of an unstable plane -> GT id holding most of its pixels
   double fraction() const { return frames > 0 ? double(consistent) / double(frames) : 1.0; }
