@@ -5,6 +5,7 @@
 // over the frames processed (metrics.json "interrupted": true, exit code 128 + the signal: 130 for
 // Ctrl-C); a second one aborts.
 #include "client/commands/command.h"
+#include "client/commands/stop_on_signal.h"
 #include "core/common/device.h"
 #include "core/io/atomic_file.h"
 #include "core/slam/runner.h"
@@ -12,9 +13,6 @@
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
-#include <unistd.h>
-
-#include <atomic>
 #include <csignal>
 #include <cstdio>
 #include <fstream>
@@ -33,37 +31,6 @@ struct RunCliOptions {
   std::vector<size_t> decomposition;
   size_t max_frames = 0, train_stride = 10;
   bool no_reflections = false, gt_poses = false, sync = false, ablate = false, no_progress = false;
-};
-
-// SIGINT / SIGTERM -> a stop request for RunOptions::stop while a run is in progress; the handlers
-// before it are restored when it ends. The handler only sets the flag, writes one line and puts the
-// default action back, so a second signal ends the process at once.
-std::atomic<int> g_stop_signal{0};
-static_assert(std::atomic<int>::is_always_lock_free, "the signal handler needs a lock-free flag");
-
-extern "C" void request_stop(int sig) {
-  g_stop_signal.store(sig);
-  constexpr char kMsg[] = "\nrrg run: stopping after this frame and writing the outputs; press Ctrl-C again to abort\n";
-  [[maybe_unused]] const ssize_t n = write(STDERR_FILENO, kMsg, sizeof(kMsg) - 1);
-  std::signal(sig, SIG_DFL);
-}
-
-class StopOnSignal {
- public:
-  StopOnSignal() : old_int_(std::signal(SIGINT, request_stop)), old_term_(std::signal(SIGTERM, request_stop)) {
-    g_stop_signal.store(0);
-  }
-  ~StopOnSignal() {
-    std::signal(SIGINT, old_int_);
-    std::signal(SIGTERM, old_term_);
-  }
-  StopOnSignal(const StopOnSignal&) = delete;
-  StopOnSignal& operator=(const StopOnSignal&) = delete;
-  int signal() const { return g_stop_signal.load(); }  // 0 while none arrived
-
- private:
-  void (*old_int_)(int);
-  void (*old_term_)(int);
 };
 
 std::string opt_cm(const std::optional<double>& v) { return v ? fmt::format("{:.2f}", *v) : std::string("-"); }
@@ -147,7 +114,7 @@ void run(const RunCliOptions& o) {
   if (!o.out.empty()) std::printf("outputs -> %s (trajectory.txt, mesh.ply/.drc, gaussians_*.ply/.spz, renders/, metrics.json, timings.json)\n", o.out.c_str());
   if (runs.back().second.metrics.interrupted) {
     std::printf("interrupted after %zu frames; the outputs above cover those frames\n", runs.back().second.metrics.frames);
-    throw ExitWith{128 + (signals.signal() != 0 ? signals.signal() : SIGINT)};  // the shell's code for a job ended by it
+    throw ExitWith{signals.exit_code()};
   }
 }
 

@@ -3,6 +3,7 @@
 // previous pose, then fused at its tracked pose. Writes the trajectory (TUM) and prints per-stage
 // milliseconds, the tracking states and, when the dataset has ground truth, the ATE.
 #include "client/commands/command.h"
+#include "client/commands/stop_on_signal.h"
 #include "core/common/device.h"
 #include "core/eval/trajectory_metrics.h"
 #include "core/io/atomic_file.h"
@@ -67,7 +68,9 @@ void run_track(const TrackOptions& o) {
   TsdfVolume volume(tsdf, device);
   TsdfModelSource model(volume, K);
   Tracker tracker(params, K, device);
-  const size_t n = o.max_frames > 0 ? std::min(dataset->size(), size_t(o.max_frames)) : dataset->size();
+  size_t n = o.max_frames > 0 ? std::min(dataset->size(), size_t(o.max_frames)) : dataset->size();
+  const StopOnSignal signals;  // Ctrl-C: stop after the current frame, still write the trajectory
+  bool interrupted = false;
   spdlog::info("track: {} ({} frames, {}x{}) on {}, tracking {}, {}", o.dataset, n, K.width, K.height,
                device.to_string(), to_string(params.mode), tsdf.to_string());
 
@@ -125,6 +128,11 @@ void run_track(const TrackOptions& o) {
       spdlog::info("track: {}/{} frames, {} ok / {} degraded / {} lost, {} orb-refined, {} keyframes, {:.1f} ms/frame",
                    i + 1, n, counts[0], counts[1], counts[2], refined, tracker.keyframes().size(),
                    ms_since(wall0) / double(i + 1));
+    if (i + 1 < n && signals.signal() != 0) {
+      spdlog::warn("track: stopped after frame {} of {}; writing the trajectory of those frames", i + 1, n);
+      n = i + 1;
+      interrupted = true;
+    }
   }
   const double wall_ms = ms_since(wall0);
   io::write_tum_trajectory(o.out, trajectory);
@@ -143,7 +151,9 @@ void run_track(const TrackOptions& o) {
               "fusion %.2f, load %.2f; wall %.1f ms/frame (%.1f FPS)\n", t_raycast * per, t_pre * per, t_icp * per,
               t_orb * per, (t_pre + t_icp + t_orb) * per, t_fuse / double(n), t_load / double(n), wall_ms / double(n),
               1000.0 * double(n) / wall_ms);
-  if (dataset->has_ground_truth()) {
+  if (dataset->has_ground_truth() && trajectory.size() < 3) {
+    std::printf("no ATE: %zu pose(s), the alignment needs at least 3\n", trajectory.size());
+  } else if (dataset->has_ground_truth()) {
     const eval::TrajectoryMetrics m = eval::evaluate_trajectory(trajectory, dataset->ground_truth());
     std::printf("ATE RMSE %.3f cm (rigid SE(3) Umeyama alignment, %zu poses; max %.3f cm, unaligned %.3f cm)\n",
                 m.ate.rmse_cm, m.ate.matched, m.ate.max_cm, m.ate.rmse_unaligned_cm);
@@ -152,6 +162,10 @@ void run_track(const TrackOptions& o) {
     const TriangleMesh mesh = extract_mesh(volume);
     io::write_ply_mesh(o.mesh, mesh);
     std::printf("mesh: %zu vertices, %zu triangles -> %s\n", mesh.vertices.size(), mesh.triangles.size(), o.mesh.c_str());
+  }
+  if (interrupted) {
+    std::printf("interrupted after %zu frames; the outputs above cover those frames\n", n);
+    throw ExitWith{signals.exit_code()};
   }
 }
 

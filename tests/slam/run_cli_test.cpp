@@ -5,18 +5,10 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
-
-#include <chrono>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <string>
-#include <thread>
-#include <vector>
-
-extern char** environ;
 
 namespace rrg {
 namespace {
@@ -58,23 +50,13 @@ TEST(RunCli, InterruptStopsAfterTheCurrentFrameAndWritesTheOutputs) {
   auto r = test::run_rrg("synth --preset living_room --frames 30 --width 160 --height 120 --novel 0 --out " + seq.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto out = dir / "run";
-  std::vector<std::string> args = {RRG_CLI,       "run",     "--dataset", seq.string(), "--out", out.string(),
-                                   "--device",    "cpu",     "--sync",    "--no-progress",
-                                   "--set",       "tsdf.voxel_size=0.02", "--set", "tsdf.truncation=0.08"};
-  std::vector<char*> argv;
-  for (std::string& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  ASSERT_EQ(posix_spawn(&pid, RRG_CLI, nullptr, nullptr, argv.data(), environ), 0);
-  // config.yaml is written once the run has started (the signal handler is installed before it).
-  for (int i = 0; i < 600 && !std::filesystem::exists(out / "config.yaml"); ++i)
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  ASSERT_TRUE(std::filesystem::exists(out / "config.yaml"));
-  ASSERT_EQ(kill(pid, SIGINT), 0);
-  int status = 0;
-  ASSERT_EQ(waitpid(pid, &status, 0), pid);
-  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
-  EXPECT_EQ(WEXITSTATUS(status), 128 + SIGINT);
+  test::BackgroundRrg rrg("run --dataset " + seq.string() + " --out " + out.string() +
+                              " --device cpu --sync --no-progress --set tsdf.voxel_size=0.02 --set tsdf.truncation=0.08",
+                          dir / "log.txt");
+  // The run has started (and its handler is installed) once it logs its first line.
+  ASSERT_TRUE(rrg.wait_for_output("run: ")) << "rrg run did not start";
+  rrg.signal(SIGINT);
+  EXPECT_EQ(rrg.wait(), 128 + SIGINT);
 
   const auto j = nlohmann::json::parse(std::ifstream(out / "metrics.json"));
   EXPECT_TRUE(j.at("interrupted").get<bool>());

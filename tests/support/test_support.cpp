@@ -5,8 +5,13 @@
 
 #include <array>
 #include <atomic>
+#include <chrono>
+#include <csignal>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <stdexcept>
+#include <thread>
 
 namespace rrg::test {
 
@@ -36,6 +41,52 @@ CommandResult run_rrg(const std::string& args) {
   const int status = ::pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
+}
+
+BackgroundRrg::BackgroundRrg(const std::string& args, const std::filesystem::path& log) : log_(log) {
+  if (!std::filesystem::exists(RRG_CLI))
+    throw std::runtime_error(std::string("the rrg executable is not built: ") + RRG_CLI);
+  const std::string cmd = "exec " + std::string(RRG_CLI) + " " + args + " > '" + log.string() + "' 2>&1";
+  pid_ = ::fork();
+  if (pid_ < 0) throw std::runtime_error("fork failed for: " + cmd);
+  if (pid_ == 0) {  // the child becomes `sh -c "exec rrg ..."`, i.e. rrg itself with the redirections
+    ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+}
+
+BackgroundRrg::~BackgroundRrg() {
+  if (pid_ > 0 && !exited_) {
+    ::kill(pid_, SIGKILL);
+    ::waitpid(pid_, nullptr, 0);
+  }
+}
+
+bool BackgroundRrg::wait_for_output(const std::string& text, double timeout_s) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (std::chrono::steady_clock::now() < end) {
+    std::ifstream f(log_);
+    const std::string content((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    if (content.find(text) != std::string::npos) return true;
+    if (::waitpid(pid_, &status_, WNOHANG) == pid_) {
+      exited_ = true;
+      return false;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return false;
+}
+
+void BackgroundRrg::signal(int sig) {
+  if (!exited_) ::kill(pid_, sig);
+}
+
+int BackgroundRrg::wait() {
+  if (!exited_) {
+    if (::waitpid(pid_, &status_, 0) != pid_) return -1;
+    exited_ = true;
+  }
+  return WIFEXITED(status_) ? WEXITSTATUS(status_) : -1;
 }
 
 std::filesystem::path test_data_dir() { return RRG_TEST_DATA_DIR; }

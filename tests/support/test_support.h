@@ -26,6 +26,25 @@ struct CommandResult {
 // Runs `rrg <args>` (the freshly built binary) through the shell and captures its output.
 CommandResult run_rrg(const std::string& args);
 
+// `rrg <args>` started in the background (stdout and stderr to `log`), for tests that signal it.
+class BackgroundRrg {
+ public:
+  BackgroundRrg(const std::string& args, const std::filesystem::path& log);
+  ~BackgroundRrg();  // kills the process if it is still running
+  BackgroundRrg(const BackgroundRrg&) = delete;
+  BackgroundRrg& operator=(const BackgroundRrg&) = delete;
+  // Waits (polling, up to timeout_s) until `log` contains `text`; false on timeout or exit.
+  bool wait_for_output(const std::string& text, double timeout_s = 60.0);
+  void signal(int sig);
+  // Waits for the process; its exit code, or -1 when a signal ended it.
+  int wait();
+
+ private:
+  int pid_ = -1, status_ = 0;
+  bool exited_ = false;
+  std::filesystem::path log_;
+};
+
 // Folder with small committed test inputs (tests/data).
 std::filesystem::path test_data_dir();
 

@@ -10,6 +10,9 @@
 
 #include <gtest/gtest.h>
 
+#include <csignal>
+#include <fstream>
+#include <iterator>
 #include <memory>
 #include <numbers>
 #include <regex>
@@ -188,6 +191,25 @@ TEST_F(SynthSequence, RrgTrackWritesTrajectoryAndMeetsAte) {
   // after rigid alignment stays below half a voxel (1 cm); a broken tracker (e.g. identity
   // poses) gives tens of cm on this moving camera.
   EXPECT_LT(ate, 1.0) << r.output;
+}
+
+// Ctrl-C: `rrg track` stops after the frame in progress, writes the trajectory of the frames it
+// tracked and exits with 128 + SIGINT.
+TEST_F(SynthSequence, RrgTrackInterruptedWritesTheFramesTracked) {
+  test::TempDir out("rrg_track_interrupt");
+  const auto traj = out / "traj.txt";
+  test::BackgroundRrg rrg("track --dataset " + root().string() + " --out " + traj.string() +
+                              " --tracking icp --voxel 0.02 --device cpu --progress 1",
+                          out / "log.txt");
+  ASSERT_TRUE(rrg.wait_for_output("track: 1/30 frames")) << "rrg track did not start";
+  rrg.signal(SIGINT);
+  EXPECT_EQ(rrg.wait(), 128 + SIGINT);
+  const io::Trajectory t = io::read_tum_trajectory(traj);
+  EXPECT_GE(t.size(), 1u);
+  EXPECT_LT(t.size(), 30u);
+  std::ifstream log(out / "log.txt");
+  const std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("interrupted after " + std::to_string(t.size()) + " frames"), std::string::npos) << text;
 }
 
 TEST_F(SynthSequence, RrgTrackUsageAndDataErrors) {
