@@ -158,7 +158,9 @@ MappingContext Session::Impl::mapping_context() {
 void Session::Impl::identify(const SessionFrame& frame, const Eigen::Isometry3f& T_wc, FrameReport& report,
                              DeviceImage<int32_t>& plane_ids, DeviceImage<uint8_t>& mask) {
   const auto t0 = Clock::now();
-  const Image<float> cvar = locked_raycast(K, T_wc).color_variance.to_host();
+  // C_var only: the identification reads no colour from the map (its colour edges are the input's).
+  const RaycastResult rc = locked_raycast(K, T_wc, RaycastOutputs{.color = false, .reflection = true});
+  const Image<float> cvar = rc.color_variance.to_host();
   IdentificationFrame f{&frame.depth, &frame.color, frame.labels ? &*frame.labels : nullptr, K, T_wc, frame.index,
                         config.tsdf.voxel_size};
   if (identifier.cue().name() == "labels" && !frame.labels) f.labels = nullptr;
