@@ -155,11 +155,31 @@ void IdentificationScorer::add(const LabelImage& gt, const Image<int32_t>& globa
   frame_ids_.push_back(std::move(ids));
 }
 
+namespace {
+
+// The id a remap table gives `id` (ids beyond the table map to themselves).
+int canonical_id(const std::vector<int32_t>& remap, int id) {
+  return id >= 0 && size_t(id) < remap.size() ? int(remap[size_t(id)]) : id;
+}
+
+// The key with the largest count.
+int majority_key(const std::map<int, int64_t>& counts) {
+  return std::max_element(counts.begin(), counts.end(), [](const auto& a, const auto& b) { return a.second < b.second; })
+      ->first;
+}
+
+}  // namespace
+
+std::map<int, std::map<int, int64_t>> IdentificationScorer::pixels_by_global(const std::vector<int32_t>& remap) const {
+  std::map<int, std::map<int, int64_t>> out;
+  for (const auto& [key, n] : pixels_) out[canonical_id(remap, key.first)][key.second] += n;
+  return out;
+}
+
 IdStability IdentificationScorer::id_stability(const std::vector<int32_t>& remap) const {
-  auto canon = [&](int id) { return id >= 0 && size_t(id) < remap.size() ? int(remap[size_t(id)]) : id; };
   std::map<int, std::map<int, int>> hist;  // GT id -> canonical id -> frames
   for (const auto& f : frame_ids_)
-    for (const auto& [g, id] : f) ++hist[g][canon(id)];
+    for (const auto& [g, id] : f) ++hist[g][canonical_id(remap, id)];
   IdStability s;
   for (const auto& [g, h] : hist) {
     int total = 0, mode = 0;
@@ -172,36 +192,27 @@ IdStability IdentificationScorer::id_stability(const std::vector<int32_t>& remap
     else
       s.unstable[g] = h;
   }
-  std::map<int, std::map<int, int64_t>> by_global;  // canonical global id -> GT id -> pixels
-  for (const auto& [key, n] : pixels_) by_global[canon(key.first)][key.second] += n;
+  const auto by_global = pixels_by_global(remap);
   for (const auto& [g, h] : s.unstable)
-    for (const auto& [id, n] : h) {
-      const auto it = by_global.find(id);
-      if (it == by_global.end()) continue;
-      s.majority_gt[id] = std::max_element(it->second.begin(), it->second.end(),
-                                           [](const auto& a, const auto& b) { return a.second < b.second; })->first;
-    }
+    for (const auto& [id, n] : h)
+      if (const auto it = by_global.find(id); it != by_global.end()) s.majority_gt[id] = majority_key(it->second);
   return s;
 }
 
 ReflectiveScores IdentificationScorer::reflective(const std::vector<int32_t>& remap, const std::set<int>& accepted,
                                                   const std::map<int, GtPlane>& gt_planes, int min_frames) const {
-  auto canon = [&](int id) { return id >= 0 && size_t(id) < remap.size() ? int(remap[size_t(id)]) : id; };
-  std::map<int, std::map<int, int64_t>> by_global, by_gt;  // canonical global -> GT -> px, and reverse
-  for (const auto& [key, n] : pixels_) {
-    by_global[canon(key.first)][key.second] += n;
-    by_gt[key.second][canon(key.first)] += n;
-  }
-  auto argmax = [](const std::map<int, int64_t>& m) {
-    return std::max_element(m.begin(), m.end(), [](const auto& a, const auto& b) { return a.second < b.second; })->first;
-  };
+  auto canon = [&](int id) { return canonical_id(remap, id); };
+  const auto by_global = pixels_by_global(remap);  // canonical global -> GT -> px
+  std::map<int, std::map<int, int64_t>> by_gt;     // and reverse
+  for (const auto& [c, gts] : by_global)
+    for (const auto& [g, n] : gts) by_gt[g][c] += n;
   ReflectiveScores s;
   for (int id : accepted) {
     const int c = canon(id);
     ++s.accepted;
     const auto it = by_global.find(c);
     if (it == by_global.end()) continue;
-    const int g = argmax(it->second);
+    const int g = majority_key(it->second);
     const auto gp = gt_planes.find(g);
     const bool ok = gp != gt_planes.end() && gp->second.reflective;
     s.accepted_correct += ok ? 1 : 0;
@@ -214,7 +225,7 @@ ReflectiveScores IdentificationScorer::reflective(const std::vector<int32_t>& re
     if (gp == gt_planes.end() || !gp->second.reflective || frames < min_frames) continue;
     ++s.gt_reflective;
     const auto it = by_gt.find(g);
-    const bool found = it != by_gt.end() && accepted_canon.count(argmax(it->second)) > 0;
+    const bool found = it != by_gt.end() && accepted_canon.count(majority_key(it->second)) > 0;
     s.gt_found += found ? 1 : 0;
     if (!found) s.missed_names.push_back(gp->second.name);
   }

@@ -82,6 +82,8 @@ class IdentificationScorer {
                               const std::map<int, GtPlane>& gt_planes, int min_frames) const;
 
  private:
+  // canonical global id -> GT id -> pixels
+  std::map<int, std::map<int, int64_t>> pixels_by_global(const std::vector<int32_t>& remap) const;
   double min_fraction_;
   std::vector<std::map<int, int>> frame_ids_;          // per frame: GT id -> majority raw global id
   std::map<std::pair<int, int>, int64_t> pixels_;      // (raw global id, GT id) -> pixels
