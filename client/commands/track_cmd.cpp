@@ -151,8 +151,8 @@ void run_track(const TrackOptions& o) {
               "fusion %.2f, load %.2f; wall %.1f ms/frame (%.1f FPS)\n", t_raycast * per, t_pre * per, t_icp * per,
               t_orb * per, (t_pre + t_icp + t_orb) * per, t_fuse / double(n), t_load / double(n), wall_ms / double(n),
               1000.0 * double(n) / wall_ms);
-  if (dataset->has_ground_truth() && trajectory.size() < 3) {
-    std::printf("no ATE: %zu pose(s), the alignment needs at least 3\n", trajectory.size());
+  if (dataset->has_ground_truth() && trajectory.size() < eval::kMinAlignedPoses) {
+    std::printf("no ATE: %zu pose(s), the alignment needs at least %zu\n", trajectory.size(), eval::kMinAlignedPoses);
   } else if (dataset->has_ground_truth()) {
     const eval::TrajectoryMetrics m = eval::evaluate_trajectory(trajectory, dataset->ground_truth());
     std::printf("ATE RMSE %.3f cm (rigid SE(3) Umeyama alignment, %zu poses; max %.3f cm, unaligned %.3f cm)\n",

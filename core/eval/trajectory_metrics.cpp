@@ -104,11 +104,11 @@ TrajectoryMetrics evaluate_trajectory(const io::Trajectory& est, const io::Traje
   out.est_poses = est.size();
   out.ref_poses = ref.size();
   const std::vector<PoseMatch> matches = associate_by_time(est, ref, params.max_time_difference);
-  if (matches.size() < 3)
+  if (matches.size() < kMinAlignedPoses)
     throw std::runtime_error("only " + std::to_string(matches.size()) + " of " + std::to_string(est.size()) +
                              " estimated poses matched one of the " + std::to_string(ref.size()) +
                              " reference poses within " + std::to_string(params.max_time_difference) +
-                             " s (need at least 3)");
+                             " s (need at least " + std::to_string(kMinAlignedPoses) + ")");
 
   std::vector<double> t;
   std::vector<Eigen::Vector3d> p_est, p_ref;

@@ -10,6 +10,7 @@
 
 #include <Eigen/Geometry>
 
+#include <cstddef>
 #include <limits>
 #include <span>
 #include <vector>
@@ -58,7 +59,10 @@ RpeResult relative_pose_error(std::span<const double> t, std::span<const Eigen::
                               std::span<const Eigen::Isometry3d> ref, double delta_s,
                               double scale = 1.0);
 
-// Associates, then ATE and RPE. Throws std::runtime_error when fewer than 3 poses match.
+// The fewest matched poses a rigid (or similarity) alignment, and so an ATE, needs.
+inline constexpr size_t kMinAlignedPoses = 3;
+
+// Associates, then ATE and RPE. Throws std::runtime_error when fewer than kMinAlignedPoses match.
 TrajectoryMetrics evaluate_trajectory(const io::Trajectory& est, const io::Trajectory& ref,
                                       const TrajectoryEvalParams& params = {});
 

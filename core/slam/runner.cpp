@@ -232,8 +232,9 @@ RunResult run_dataset(const RunOptions& o) {
   m.reflection_gaussians = st.mapping.reflection_gaussians;
   m.reflective_planes = int64_t(st.reflective_planes.size());
   result.trajectory = session.trajectory();
-  if (dataset->has_ground_truth() && result.trajectory.size() < 3) {
-    spdlog::warn("run: no ATE: {} pose(s), the alignment needs at least 3", result.trajectory.size());
+  if (dataset->has_ground_truth() && result.trajectory.size() < eval::kMinAlignedPoses) {
+    spdlog::warn("run: no ATE: {} pose(s), the alignment needs at least {}", result.trajectory.size(),
+                 eval::kMinAlignedPoses);
   } else if (dataset->has_ground_truth()) {
     io::Trajectory gt = dataset->ground_truth();
     if (gt.size() > n) gt.resize(n);
