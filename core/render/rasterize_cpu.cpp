@@ -80,14 +80,14 @@ void base_fwd_cpu(BaseFwdArgs a) {
     float D_t[kTilePixels];
     for (int y = tp.y0; y < tp.y1; ++y)
       for (int x = tp.x0; x < tp.x1; ++x) D_t[tp.local(x, y)] = a.D_t(x, y);
-    for_each_reaching_splat(a.bins, a.splats, bounds, tile, tp, [] { return true; },
-                            [&](int32_t, const Splat& s, const TilePixels& p) {
-        for (int y = p.y0; y < p.y1; ++y)
-          for (int x = p.x0; x < p.x1; ++x) {
-            const int l = tp.local(x, y);
-            base_accumulate(acc[l], s, float(x), float(y), D_t[l], a.eps);
-          }
-                            });
+    const auto splat_fwd = [&](int32_t, const Splat& s, const TilePixels& p) {
+      for (int y = p.y0; y < p.y1; ++y)
+        for (int x = p.x0; x < p.x1; ++x) {
+          const int l = tp.local(x, y);
+          base_accumulate(acc[l], s, float(x), float(y), D_t[l], a.eps);
+        }
+    };
+    for_each_reaching_splat(a.bins, a.splats, bounds, tile, tp, [] { return true; }, splat_fwd);
     for (int y = tp.y0; y < tp.y1; ++y)
       for (int x = tp.x0; x < tp.x1; ++x) {
         const int l = tp.local(x, y);
@@ -122,16 +122,16 @@ void base_bwd_cpu(BaseBwdArgs a) {
         up[l] = base_resolve_bwd(a.W_g(x, y), D_t[l], Vec3<float>(a.C_b(x, y)), a.D_b(x, y), v_C_b, v_D_b);
       }
     if (!any) return;
-    for_each_reaching_splat(a.bins, a.splats, bounds, tile, tp, [] { return true; },
-                            [&](int32_t g, const Splat& s, const TilePixels& p) {
-        SplatGrad v{};
-        for (int y = p.y0; y < p.y1; ++y)
-          for (int x = p.x0; x < p.x1; ++x) {
-            const int l = tp.local(x, y);
-            if (active[l]) base_splat_bwd(s, float(x), float(y), D_t[l], a.eps, up[l], v);
-          }
-        if (!is_zero(v)) accumulate_grad(CpuBackend{}, &a.v_splats[g], v);
-                            });
+    const auto splat_bwd = [&](int32_t g, const Splat& s, const TilePixels& p) {
+      SplatGrad v{};
+      for (int y = p.y0; y < p.y1; ++y)
+        for (int x = p.x0; x < p.x1; ++x) {
+          const int l = tp.local(x, y);
+          if (active[l]) base_splat_bwd(s, float(x), float(y), D_t[l], a.eps, up[l], v);
+        }
+      if (!is_zero(v)) accumulate_grad(CpuBackend{}, &a.v_splats[g], v);
+    };
+    for_each_reaching_splat(a.bins, a.splats, bounds, tile, tp, [] { return true; }, splat_bwd);
   });
 }
 
@@ -150,15 +150,15 @@ void refl_fwd_cpu(ReflFwdArgs a) {
         alive[l] = refl_pixel_active(a.mode, a.plane, I[l]);
         live += alive[l] ? 1 : 0;
       }
-    for_each_reaching_splat(a.bins, a.splats, bounds, tile, tp, [&] { return live > 0; },
-                            [&](int32_t g, const Splat& s, const TilePixels& p) {
-        for (int y = p.y0; y < p.y1; ++y)
-          for (int x = p.x0; x < p.x1; ++x) {
-            const int l = tp.local(x, y);
-            if (!alive[l] || (a.mode == PlaneMode::Match && a.plane_ids[g] != I[l])) continue;  // 1(l_i == I(u))
-            if (!refl_step(st[l], s, float(x), float(y))) alive[l] = false, --live;           // early termination
-          }
-                            });
+    const auto splat_fwd = [&](int32_t g, const Splat& s, const TilePixels& p) {
+      for (int y = p.y0; y < p.y1; ++y)
+        for (int x = p.x0; x < p.x1; ++x) {
+          const int l = tp.local(x, y);
+          if (!alive[l] || (a.mode == PlaneMode::Match && a.plane_ids[g] != I[l])) continue;  // 1(l_i == I(u))
+          if (!refl_step(st[l], s, float(x), float(y))) alive[l] = false, --live;           // early termination
+        }
+    };
+    for_each_reaching_splat(a.bins, a.splats, bounds, tile, tp, [&] { return live > 0; }, splat_fwd);
     for (int y = tp.y0; y < tp.y1; ++y)
       for (int x = tp.x0; x < tp.x1; ++x) {
         const int l = tp.local(x, y);
@@ -190,18 +190,18 @@ void refl_bwd_cpu(ReflBwdArgs a) {
         alive[l] = true;
         ++live;
       }
-    for_each_reaching_splat(a.bins, a.splats, bounds, tile, tp, [&] { return live > 0; },
-                            [&](int32_t g, const Splat& s, const TilePixels& p) {
-        SplatGrad v{};
-        for (int y = p.y0; y < p.y1; ++y)
-          for (int x = p.x0; x < p.x1; ++x) {
-            const int l = tp.local(x, y);
-            if (!alive[l] || (a.mode == PlaneMode::Match && a.plane_ids[g] != I[l])) continue;
-            if (!refl_step_bwd(st[l], s, float(x), float(y), C_final[l], W_final[l], v_C[l], 0.0f, v))
-              alive[l] = false, --live;
-          }
-        if (!is_zero(v)) accumulate_grad(CpuBackend{}, &a.v_splats[g], v);
-                            });
+    const auto splat_bwd = [&](int32_t g, const Splat& s, const TilePixels& p) {
+      SplatGrad v{};
+      for (int y = p.y0; y < p.y1; ++y)
+        for (int x = p.x0; x < p.x1; ++x) {
+          const int l = tp.local(x, y);
+          if (!alive[l] || (a.mode == PlaneMode::Match && a.plane_ids[g] != I[l])) continue;
+          if (!refl_step_bwd(st[l], s, float(x), float(y), C_final[l], W_final[l], v_C[l], 0.0f, v))
+            alive[l] = false, --live;
+        }
+      if (!is_zero(v)) accumulate_grad(CpuBackend{}, &a.v_splats[g], v);
+    };
+    for_each_reaching_splat(a.bins, a.splats, bounds, tile, tp, [&] { return live > 0; }, splat_bwd);
   });
 }
 
