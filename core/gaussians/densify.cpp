@@ -143,7 +143,7 @@ GaussianHost densify_base(const DensifyView& v, const DensifyParams& p, int sh_d
   std::unordered_set<int32_t> reflective_ids;
   if (leave) {
     check_image(v.R, v.K, "R");
-    check_image(v.C_var, v.K, "C_var");
+    if (p.reflection_variance_gate) check_image(v.C_var, v.K, "C_var");
     check_image(v.I, v.K, "I");
     for (const ReflectivePlane& pl : reflective) reflective_ids.insert(pl.id);
   }
@@ -155,7 +155,8 @@ GaussianHost densify_base(const DensifyView& v, const DensifyParams& p, int sh_d
       const float z = (*v.D_gt)(x, y);
       if (!(z > 0)) continue;
       if (!(color_error((*v.C_gt)(x, y), (*v.C)(x, y)) > p.base_error && (*v.W_b)(x, y) < p.base_weight)) continue;
-      if (leave && (*v.R)(x, y) != 0 && (*v.C_var)(x, y) > p.variance && reflective_ids.count((*v.I)(x, y)) > 0)
+      if (leave && (*v.R)(x, y) != 0 && (!p.reflection_variance_gate || (*v.C_var)(x, y) > p.variance) &&
+          reflective_ids.count((*v.I)(x, y)) > 0)
         continue;
       if (!(pixel_uniform(seed, int64_t(y) * v.K.width + x) < p.sample_ratio)) continue;
       pts.push_back(v.T_wc * v.K.unproject(float(x), float(y), z));
@@ -174,7 +175,7 @@ GaussianHost densify_reflection(const DensifyView& v, std::span<const Reflective
   check_image(v.C_b, v.K, "C_b");
   check_image(v.W_r, v.K, "W_r");
   check_image(v.R, v.K, "R");
-  check_image(v.C_var, v.K, "C_var");
+  if (p.reflection_variance_gate) check_image(v.C_var, v.K, "C_var");
   check_image(v.I, v.K, "I");
   std::unordered_map<int32_t, Eigen::Vector4f> by_id;
   for (const ReflectivePlane& pl : planes) {
@@ -202,7 +203,7 @@ GaussianHost densify_reflection(const DensifyView& v, std::span<const Reflective
       ++masked;
       if (!(color_error((*v.C_gt)(x, y), (*v.C)(x, y)) > p.reflection_error)) continue;
       ++wrong;
-      if (!((*v.C_var)(x, y) > p.variance)) continue;
+      if (p.reflection_variance_gate && !((*v.C_var)(x, y) > p.variance)) continue;
       ++varying;
       if (!((*v.W_r)(x, y) < p.reflection_weight)) continue;
       ++uncovered;

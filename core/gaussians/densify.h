@@ -5,7 +5,8 @@
 //
 // Base G_b:  |C_gt − C| > δ_b and W_b < δ_w,b, and observed depth D_gt > 0. The position is the
 //            back-projected observed depth.
-// Reflection G_r: R = 1, |C_gt − C| > δ_r, C_var > δ_v, W_r < δ_w,r, and I(u) a plane of L_ref.
+// Reflection G_r: R = 1, |C_gt − C| > δ_r, W_r < δ_w,r, and I(u) a plane of L_ref; the paper's
+//            per-pixel C_var > δ_v as well only with reflection_variance_gate (see below).
 //            Ten Gaussians per sample, evenly spaced 2–8 m past the ray–plane intersection along
 //            the viewing ray (virtual space), with the plane id ℓ = I(u).
 // |C_gt − C| is the mean absolute difference over the three channels.
@@ -56,6 +57,13 @@ struct DensifyParams {
   // Reflection positions: false = the paper's samples along the ray 2–8 m past the plane; true =
   // one Gaussian at the mirrored surface (DensifyView::virtual_depth) where it is known.
   bool reflection_mirrored_depth = false;
+  // The paper's per-pixel C_var > δ_v test for reflection candidates. Off by default: the plane
+  // already passed the variance vote (δ_area) to enter L_ref and R marks its reflective region,
+  // while a mirror that reflects a uniform surface has no temporal variance there. With the gate,
+  // C_var > δ_v held on about half the mirror of mirror_room; base Gaussians took the rest with the
+  // TSDF's average reflection, a haze over the whole mirror (docs/mapping.md: +1.3 dB with the
+  // gate, +2.4 dB without it on held-out reflective pixels).
+  bool reflection_variance_gate = false;
   void validate() const;             // throws std::invalid_argument naming the bad field
 };
 
@@ -76,8 +84,8 @@ struct DensifyView {
 };
 
 // With `reflective` planes given (and params.base_leaves_reflections), the pixels that the
-// reflection set may take (R = 1 on one of those planes and C_var > δ_v: temporally varying
-// appearance on a reflective plane) get no base Gaussians: their error is the reflection's to fit.
+// reflection set may take (R = 1 on one of those planes, and C_var > δ_v with the variance gate)
+// get no base Gaussians: their error is the reflection's to fit.
 GaussianHost densify_base(const DensifyView& view, const DensifyParams& params, int sh_degree, uint64_t seed,
                           std::span<const ReflectivePlane> reflective = {});
 GaussianHost densify_reflection(const DensifyView& view, std::span<const ReflectivePlane> planes,

@@ -34,7 +34,9 @@ void add_mapper_config_fields(ConfigTable& t, MapperParams& p) {
   t.f("densify.base_error", p.densify.base_error, "δ_b: colour error for base densification");
   t.f("densify.base_weight", p.densify.base_weight, "δ_w,b: base weight below which to densify");
   t.f("densify.reflection_error", p.densify.reflection_error, "δ_r: colour error for reflection densification");
-  t.f("densify.variance", p.densify.variance, "δ_v: colour variance for reflection densification");
+  t.f("densify.variance", p.densify.variance, "δ_v: colour variance for reflection densification (with the gate)");
+  t.b("densify.reflection_variance_gate", p.densify.reflection_variance_gate,
+      "the paper's per-pixel C_var > δ_v test for new reflection Gaussians (off: R = 1 on an accepted plane suffices)");
   t.f("densify.reflection_weight", p.densify.reflection_weight, "δ_w,r: reflection weight below which to densify");
   t.f("densify.sample_ratio", p.densify.sample_ratio, "fraction of candidate pixels that get Gaussians");
   t.i("densify.reflection_samples", p.densify.reflection_samples, "Gaussians per reflection sample along the ray");

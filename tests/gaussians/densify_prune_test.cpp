@@ -70,8 +70,9 @@ TEST(Densify, BaseCandidatesFollowErrorAndWeightRules) {
   }
 }
 
-// base_leaves_reflections: pixels the reflection set may take (R = 1, C_var > δ_v, on a given
-// reflective plane) get no base Gaussian; every other candidate still does; off = the plain rule.
+// base_leaves_reflections: pixels the reflection set may take (R = 1 on a given reflective plane,
+// and C_var > δ_v with the variance gate) get no base Gaussian; every other candidate still does;
+// off = the plain rule.
 TEST(Densify, BaseLeavesReflectionCandidatesWhenAsked) {
   WallView w;
   for (auto& c : w.C.pixels()) c = Color(0.8f, 0.4f, 0.0f);       // every pixel a base candidate
@@ -86,8 +87,12 @@ TEST(Densify, BaseLeavesReflectionCandidatesWhenAsked) {
   p.base_leaves_reflections = true;
   EXPECT_EQ(densify_base(w.view(), p, 0, 3).size(), size_t(32 * 24));          // no planes given
   const GaussianHost g = densify_base(w.view(), p, 0, 3, planes);
-  EXPECT_EQ(g.size(), size_t(10 * 24));  // columns 0-9 only
-  for (const auto& m : g.means) EXPECT_LT(w.K.project(m).x(), 9.5f);
+  EXPECT_EQ(g.size(), size_t(9 * 24));  // columns 0-7 and 9 (column 8 is the reflection set's too)
+  for (const auto& m : g.means) EXPECT_TRUE(std::abs(w.K.project(m).x() - 8.0f) > 0.5f && w.K.project(m).x() < 9.5f);
+  p.reflection_variance_gate = true;     // with the paper's gate, column 8 is not
+  const GaussianHost gated = densify_base(w.view(), p, 0, 3, planes);
+  EXPECT_EQ(gated.size(), size_t(10 * 24));  // columns 0-9
+  for (const auto& m : gated.means) EXPECT_LT(w.K.project(m).x(), 9.5f);
 }
 
 TEST(Densify, ScaleFromThreeNearestNewPoints) {
@@ -118,15 +123,20 @@ TEST(Densify, SamplingIsDeterministicAndRespectsTheRatio) {
 TEST(Densify, ReflectionSamplesLiePastThePlaneAlongTheRay) {
   WallView w;
   for (auto& c : w.C.pixels()) c = Color::Zero();   // error 0.47 everywhere
-  for (int x = 0; x < 32; ++x) w.C_var(x, 0) = 0.005f;  // row 0: variance too low
+  for (int x = 0; x < 32; ++x) w.C_var(x, 0) = 0.005f;  // row 0: variance below δ_v
   for (int x = 0; x < 32; ++x) w.R(x, 1) = 0;           // row 1: not reflective
   for (int x = 0; x < 32; ++x) w.W_r(x, 2) = 0.5f;      // row 2: covered
   for (int x = 0; x < 32; ++x) w.I(x, 3) = 9;           // row 3: plane not in L_ref
   const std::vector<ReflectivePlane> planes = {{4, Eigen::Vector4f(0, 0, -2, 4)}};  // z = 2 (unnormalised)
   DensifyParams p;
   p.sample_ratio = 1.0f;
+  // Row 0 is a candidate by default (R = 1 on an accepted plane suffices), not with the paper's
+  // per-pixel variance gate.
+  EXPECT_EQ(densify_reflection(w.view(), planes, p, 0, 3).size(), size_t(21 * 32 * 10));
+  p.reflection_variance_gate = true;
   const GaussianHost g = densify_reflection(w.view(), planes, p, 0, 3);
   ASSERT_EQ(g.size(), size_t(20 * 32 * 10));
+  for (size_t s = 0; s < g.size(); s += 10) EXPECT_GT(w.K.project(g.means[s]).y(), 0.5f);  // not row 0
   for (size_t s = 0; s < g.size(); s += 10) {
     const Eigen::Vector3f dir = g.means[s].normalized();
     const Eigen::Vector3f hit = dir * (2.0f / dir.z());
