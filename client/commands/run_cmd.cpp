@@ -47,6 +47,19 @@ void print_table(const std::vector<std::pair<std::string, RunResult>>& runs) {
   }
 }
 
+// Held-out PSNR of each ground-truth reflective plane scored in both runs (same names, same pixels).
+struct PlaneDelta {
+  std::string name;
+  double with = 0, without = 0;
+};
+std::vector<PlaneDelta> reflective_plane_deltas(const ImageScores& with, const ImageScores& without) {
+  std::vector<PlaneDelta> out;
+  for (const PlaneScore& a : with.reflective_planes)
+    for (const PlaneScore& b : without.reflective_planes)
+      if (a.id == b.id && a.pixels == b.pixels) out.push_back({a.name, a.psnr, b.psnr});
+  return out;
+}
+
 void print_timings(const RunTimings& t, const std::string& device) {
   std::printf("timing (%s, ms/frame): load %.2f | raycast %.2f preprocess %.2f icp %.2f orb %.2f fuse %.2f identify %.2f"
               " = pre-mapping %.2f | mapping %.2f ms/step x %lld steps (%.2f ms/frame waited or inline) | wall %.2f ms/frame"
@@ -101,6 +114,14 @@ void run(const RunCliOptions& o) {
                 a.held_out.psnr_reflective - b.held_out.psnr_reflective, a.held_out.psnr - b.held_out.psnr,
                 a.train.psnr_reflective - b.train.psnr_reflective,
                 (a.ate_rmse_cm && b.ate_rmse_cm) ? *a.ate_rmse_cm - *b.ate_rmse_cm : 0.0);
+    const auto plane_deltas = reflective_plane_deltas(a.held_out, b.held_out);
+    if (!plane_deltas.empty()) {
+      std::printf("held-out views by ground-truth reflective plane (reflections vs no-reflections):");
+      for (const PlaneDelta& d : plane_deltas)
+        std::printf(" %s %.2f vs %.2f dB (%+.2f)%s", d.name.c_str(), d.with, d.without, d.with - d.without,
+                    &d == &plane_deltas.back() ? "" : ",");
+      std::printf("\n");
+    }
     if (!o.out.empty())
       io::write_atomically(std::filesystem::path(o.out) / "ablation.json", [&](const std::filesystem::path& tmp) {
         nlohmann::ordered_json j;
@@ -108,6 +129,7 @@ void run(const RunCliOptions& o) {
         j["no_reflections"] = nlohmann::json::parse(metrics_json(b));
         j["delta_psnr_reflective_held_out_db"] = a.held_out.psnr_reflective - b.held_out.psnr_reflective;
         j["delta_psnr_held_out_db"] = a.held_out.psnr - b.held_out.psnr;
+        for (const PlaneDelta& d : plane_deltas) j["delta_psnr_held_out_by_reflective_plane_db"][d.name] = d.with - d.without;
         std::ofstream(tmp) << j.dump(2) << "\n";
       });
   }

@@ -11,6 +11,7 @@
 #include "core/io/ply.h"
 #include "core/io/synth_layout.h"
 #include "core/io/trajectory.h"
+#include "core/planes/plane_metrics.h"
 #include "core/planes/semantic_labels.h"
 #include "core/slam/run_outputs.h"
 
@@ -21,6 +22,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 namespace rrg {
@@ -49,15 +51,38 @@ struct MaskedSse {
   double psnr() const { return pixels ? 10.0 * std::log10(1.0 / (sse / double(3 * pixels))) : 0.0; }
 };
 
+// Ground truth of a synthetic view for the reflective scores: the reflection mask and the plane ids.
+struct ReflectiveTruth {
+  MaskImage reflection;
+  LabelImage planes;
+};
+
+// The plane ids only where the dataset has them (per-plane scores are skipped without).
+ReflectiveTruth read_reflective_truth(const std::filesystem::path& root, size_t i) {
+  const bool planes = std::filesystem::exists(io::synth_extra_path(root, "planes", i));
+  return {io::read_synth_reflection(root, i), planes ? io::read_synth_planes(root, i) : LabelImage()};
+}
+
 struct ScoreAccumulator {
   double psnr = 0, ssim = 0;
   size_t views = 0;
   MaskedSse reflective;
-  void add(const ColorImage& est, const ColorImage& ref, const MaskImage* reflection) {
+  std::map<int, GtPlane> reflective_planes;  // ground-truth reflective planes (synth), by id
+  std::map<int, MaskedSse> by_plane;
+  void add(const ColorImage& est, const ColorImage& ref, const ReflectiveTruth* truth) {
     psnr += std::min(eval::psnr(est, ref), 100.0);
     ssim += eval::ssim(est, ref);
     ++views;
-    if (reflection) reflective.add(est, ref, *reflection);
+    if (!truth) return;
+    reflective.add(est, ref, truth->reflection);
+    if (truth->planes.width() != ref.width() || truth->planes.height() != ref.height()) return;
+    for (const auto& [id, plane] : reflective_planes) {
+      MaskImage on(ref.width(), ref.height(), 0);
+      bool any = false;
+      for (size_t k = 0; k < on.size(); ++k)
+        if (int(truth->planes[k]) == id) on[k] = 1, any = true;
+      if (any) by_plane[id].add(est, ref, on);
+    }
   }
   ImageScores scores() const {
     ImageScores s;
@@ -65,9 +90,19 @@ struct ScoreAccumulator {
     if (views) s.psnr = psnr / double(views), s.ssim = ssim / double(views);
     s.psnr_reflective = reflective.psnr();
     s.reflective_pixels = reflective.pixels;
+    for (const auto& [id, sse] : by_plane) s.reflective_planes.push_back({id, reflective_planes.at(id).name, sse.pixels, sse.psnr()});
     return s;
   }
 };
+
+// The reflective planes of a synthetic dataset's planes.json (none without the file).
+std::map<int, GtPlane> reflective_gt_planes(const std::filesystem::path& file) {
+  std::map<int, GtPlane> out;
+  if (!std::filesystem::exists(file)) return out;
+  for (auto& [id, p] : read_gt_planes(file))
+    if (p.reflective) out.emplace(id, std::move(p));
+  return out;
+}
 
 // A one-line progress bar with live FPS on stderr (rewritten in place on a terminal).
 class ProgressBar {
@@ -242,10 +277,11 @@ RunResult run_dataset(const RunOptions& o) {
   }
   const bool synth = dataset->format() == io::DatasetFormat::Synth;
   RunOutputs outputs(o.out, o.write_renders);
+  if (synth) train.reflective_planes = reflective_gt_planes(io::synth_scene_file(dataset->root(), "planes.json"));
   for (const auto& [i, gt_color] : train_views) {
     const SessionView v = session.render(config.K, reports[i].T_wc);
-    const MaskImage reflection = synth ? io::read_synth_reflection(dataset->root(), i) : MaskImage();
-    train.add(v.C, gt_color, synth ? &reflection : nullptr);
+    const ReflectiveTruth truth = synth ? read_reflective_truth(dataset->root(), i) : ReflectiveTruth{};
+    train.add(v.C, gt_color, synth ? &truth : nullptr);
   }
   m.train = train.scores();
   for (size_t i : o.decomposition_frames) {
@@ -259,12 +295,13 @@ RunResult run_dataset(const RunOptions& o) {
   if (synth && std::filesystem::exists(o.dataset / "novel")) {  // held-out views, never optimised on
     const auto novel = io::open_dataset(o.dataset / "novel");
     ScoreAccumulator held;
+    held.reflective_planes = train.reflective_planes;
     for (size_t i = 0; i < novel->size(); ++i) {
       const io::Frame f = novel->load(i);
       if (!f.T_wc_gt) continue;
       const SessionView v = session.render(novel->intrinsics(), f.T_wc_gt->cast<float>());
-      const MaskImage reflection = io::read_synth_reflection(o.dataset / "novel", i);
-      held.add(v.C, f.color, &reflection);
+      const ReflectiveTruth truth = read_reflective_truth(o.dataset / "novel", i);
+      held.add(v.C, f.color, &truth);
       outputs.render("novel_" + std::to_string(i), v, &f.color);
     }
     m.held_out = held.scores();
@@ -327,6 +364,9 @@ std::string metrics_json(const RunMetrics& m) {
     x["ssim"] = s.ssim;
     x["psnr_reflective_db"] = s.psnr_reflective;
     x["reflective_pixels"] = s.reflective_pixels;
+    x["reflective_planes"] = nlohmann::ordered_json::array();
+    for (const PlaneScore& p : s.reflective_planes)
+      x["reflective_planes"].push_back({{"id", p.id}, {"name", p.name}, {"pixels", p.pixels}, {"psnr_db", p.psnr}});
     return x;
   };
   j["train"] = scores(m.train);

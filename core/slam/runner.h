@@ -42,11 +42,21 @@ struct NamedPose {
 };
 std::vector<NamedPose> read_render_poses(const std::filesystem::path& file);
 
+// PSNR over the pixels of one ground-truth reflective plane (synthetic planes.json), pooled over
+// the views that see it: the mirror alone, say, where the reflective mask also pools a glossy floor.
+struct PlaneScore {
+  int id = 0;
+  std::string name;
+  size_t pixels = 0;
+  double psnr = 0;
+};
+
 struct ImageScores {
   size_t views = 0;
   double psnr = 0, ssim = 0;          // means over views
   double psnr_reflective = 0;         // PSNR over the pooled reflective pixels (ground-truth mask)
   size_t reflective_pixels = 0;
+  std::vector<PlaneScore> reflective_planes;  // per ground-truth reflective plane seen, by id
 };
 
 struct RunMetrics {

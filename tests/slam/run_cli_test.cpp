@@ -1,5 +1,7 @@
 // `rrg run` through the real executable on a short synthetic sequence: the files it promises and
 // the metrics in metrics.json, including completion over the observed part of the ground truth.
+#include "core/io/synth_layout.h"
+#include "core/planes/plane_metrics.h"
 #include "tests/support/test_support.h"
 
 #include <gtest/gtest.h>
@@ -8,6 +10,7 @@
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
 
 namespace rrg {
@@ -40,6 +43,27 @@ TEST(RunCli, WritesOutputsAndScoresGeometryOnTheObservedSurface) {
   EXPECT_LT(comp, 3.0) << j.dump(2);
   EXPECT_LT(g.at("accuracy_cm").get<double>(), 3.0) << j.dump(2);
   EXPECT_GT(g.at("completion_ratio_3cm").get<double>(), 0.8) << j.dump(2);
+
+  // Held-out PSNR per ground-truth reflective plane: one entry per reflective plane of planes.json
+  // that a novel view sees, over exactly that plane's pixels in novel/planes/.
+  const auto gt_planes = read_gt_planes(seq / "planes.json");
+  std::map<int, size_t> seen;
+  for (size_t i = 0; i < 2; ++i) {
+    const LabelImage ids = io::read_synth_planes(seq / "novel", i);
+    for (size_t k = 0; k < ids.size(); ++k)
+      if (gt_planes.count(int(ids[k])) && gt_planes.at(int(ids[k])).reflective) ++seen[int(ids[k])];
+  }
+  ASSERT_FALSE(seen.empty()) << "the novel views should see the floor";
+  const auto& per_plane = j.at("held_out").at("reflective_planes");
+  ASSERT_EQ(per_plane.size(), seen.size()) << per_plane.dump(2);
+  for (const auto& e : per_plane) {
+    const int id = e.at("id").get<int>();
+    ASSERT_TRUE(seen.count(id)) << id;
+    EXPECT_EQ(e.at("pixels").get<size_t>(), seen.at(id));
+    EXPECT_EQ(e.at("name").get<std::string>(), gt_planes.at(id).name);
+    EXPECT_GT(e.at("psnr_db").get<double>(), 5.0);
+    EXPECT_LT(e.at("psnr_db").get<double>(), 60.0);
+  }
 }
 
 // Ctrl-C during a run: the run stops after the current frame and still writes every output over
