@@ -13,10 +13,10 @@
 //
 // Initialisation: scale s = sqrt(mean of the squared distances to the 3 nearest new points of the
 // same call), clamped to [min_init_scale, max_init_scale] (neighbours farther than the cap count as
-// the cap). Base: 1 cm (GPS-SLAM). Reflection: 10 cm — reflection Gaussians sit 2–8 m past the
-// plane, where 1 cm is a tenth of a pixel at 640 px and the nearest new points on neighbouring rays
-// are centimetres apart; the cap keeps them under the reflection prune maximum (0.2 m); the Gaussian is flattened along the surface normal (base: normal of the observed depth;
-// reflection: plane normal) to flatten · s; opacity 0.5; SH DC from the colour, higher bands 0.
+// the cap). The cap is 1 cm for both sets (GPS-SLAM; the paper initialises reflection Gaussians
+// "in the same manner as base Gaussians"). The Gaussian is flattened along the surface normal
+// (base: normal of the observed depth; reflection: plane normal) to flatten · s; opacity 0.5; SH DC
+// from the colour, higher bands 0.
 // Colour = C_gt(u) for both sets (the paper); reflection_residual_color uses max(C_gt − C_b, 0)
 // instead (C = C_b + R C_r is additive, so the pixel colour counts the base twice at first).
 // min_init_scale keeps a new Gaussian above the prune threshold of its set (else it would be
@@ -47,7 +47,7 @@ struct DensifyParams {
   float reflection_near = 2.0f;      // metres past the ray–plane intersection
   float reflection_far = 8.0f;
   float max_init_scale = 0.01f;      // 1 cm cap (GPS-SLAM), base Gaussians
-  float reflection_max_init_scale = 0.1f;  // reflection cap: half the reflection prune max (0.2)
+  float reflection_max_init_scale = 0.01f;  // reflection cap: 1 cm, as the base (the paper)
   float base_min_init_scale = 0.0045f;        // 1.5 x the base prune min scale (0.003)
   float reflection_min_init_scale = 0.0075f;  // 1.5 x the reflection prune min scale (0.005)
   float flatten = 0.1f;              // normal-axis scale / tangential scale
