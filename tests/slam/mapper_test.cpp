@@ -162,9 +162,10 @@ TEST(Mapper, FitsOneViewAbove35dB) {
 
 // mirror_room with ground-truth poses and the known mirror plane: the same frames mapped with and
 // without reflection Gaussians, evaluated on held-out novel views over the mirror's pixels (pooled
-// MSE), in one run. Issue 7 asks for >= 3 dB; this implementation reaches about +0.9 dB here
-// (64x48, 40 frames; +1.6 dB at 128x96), so the test asserts the direction with a margin, and the
-// gap is an open item (docs/mapping.md "Status").
+// MSE), in one run. Issue 7 asks for >= 3 dB: `rrg run --gt-poses --ablate-reflections` on 300
+// frames at 320x240 gives it (docs/mapping.md "Status"); this short 64x48 sequence of 40 frames
+// gives +1.5 dB (+1.0 before the variance gate went and the reflection scale cap became 1 cm), so
+// the test asserts +1 dB, the direction with a margin.
 TEST(Mapper, ReflectionsImproveTheMirrorOnNovelViews) {
   test::MapperSceneParams sp;
   sp.preset = "mirror_room";
@@ -259,7 +260,7 @@ TEST(Mapper, ReflectionsImproveTheMirrorOnNovelViews) {
               "base only %.2f dB, base + reflection %.2f dB (%zu base + %zu reflection Gaussians vs %zu base)\n",
               s.K.width, s.K.height, s.frames.size(), views, (long long)(n / 3), psnr_tsdf, psnr_without, psnr_with,
               with->base_host().size(), with->reflection_host().size(), without->base_host().size());
-  EXPECT_GE(psnr_with - psnr_without, 0.5);
+  EXPECT_GE(psnr_with - psnr_without, 1.0);
 }
 
 }  // namespace
