@@ -61,8 +61,8 @@ struct DensifyParams {
   // already passed the variance vote (δ_area) to enter L_ref and R marks its reflective region,
   // while a mirror that reflects a uniform surface has no temporal variance there. With the gate,
   // C_var > δ_v held on about half the mirror of mirror_room; base Gaussians took the rest with the
-  // TSDF's average reflection, a haze over the whole mirror (docs/mapping.md: +1.3 dB with the
-  // gate, +2.4 dB without it on held-out reflective pixels).
+  // TSDF's average reflection, a haze over the whole mirror (docs/mapping.md: held-out reflective
+  // pixels +1.3 dB over base only with the gate, +2.4 dB without it, both with a 10 cm scale cap).
   bool reflection_variance_gate = false;
   void validate() const;             // throws std::invalid_argument naming the bad field
 };
