@@ -40,13 +40,13 @@ double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std
 struct MaskedSse {
   double sse = 0;
   size_t pixels = 0;
+  void add(const Color& est, const Color& ref) {
+    sse += double((est - ref).squaredNorm());
+    ++pixels;
+  }
   void add(const ColorImage& est, const ColorImage& ref, const MaskImage& mask) {
-    for (int y = 0; y < ref.height(); ++y)
-      for (int x = 0; x < ref.width(); ++x)
-        if (mask(x, y)) {
-          sse += double((est(x, y) - ref(x, y)).squaredNorm());
-          ++pixels;
-        }
+    for (size_t k = 0; k < ref.size(); ++k)
+      if (mask[k]) add(est[k], ref[k]);
   }
   double psnr() const { return pixels ? 10.0 * std::log10(1.0 / (sse / double(3 * pixels))) : 0.0; }
 };
@@ -76,13 +76,8 @@ struct ScoreAccumulator {
     if (!truth) return;
     reflective.add(est, ref, truth->reflection);
     if (truth->planes.width() != ref.width() || truth->planes.height() != ref.height()) return;
-    for (const auto& [id, plane] : reflective_planes) {
-      MaskImage on(ref.width(), ref.height(), 0);
-      bool any = false;
-      for (size_t k = 0; k < on.size(); ++k)
-        if (int(truth->planes[k]) == id) on[k] = 1, any = true;
-      if (any) by_plane[id].add(est, ref, on);
-    }
+    for (size_t k = 0; k < ref.size(); ++k)  // one pass: each pixel to its reflective plane, if any
+      if (const int id = int(truth->planes[k]); id != 0 && reflective_planes.count(id)) by_plane[id].add(est[k], ref[k]);
   }
   ImageScores scores() const {
     ImageScores s;

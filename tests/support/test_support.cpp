@@ -28,10 +28,17 @@ TempDir::~TempDir() {
   std::filesystem::remove_all(path_, ec);
 }
 
-CommandResult run_rrg(const std::string& args) {
+namespace {
+// "<rrg> args" for the shell; throws when the executable is not built.
+std::string rrg_command(const std::string& args) {
   if (!std::filesystem::exists(RRG_CLI))
     throw std::runtime_error(std::string("the rrg executable is not built: ") + RRG_CLI);
-  const std::string cmd = std::string(RRG_CLI) + " " + args + " 2>&1";
+  return std::string(RRG_CLI) + " " + args;
+}
+}  // namespace
+
+CommandResult run_rrg(const std::string& args) {
+  const std::string cmd = rrg_command(args) + " 2>&1";
   FILE* pipe = ::popen(cmd.c_str(), "r");
   if (!pipe) throw std::runtime_error("popen failed for: " + cmd);
   CommandResult result;
@@ -44,9 +51,7 @@ CommandResult run_rrg(const std::string& args) {
 }
 
 BackgroundRrg::BackgroundRrg(const std::string& args, const std::filesystem::path& log) : log_(log) {
-  if (!std::filesystem::exists(RRG_CLI))
-    throw std::runtime_error(std::string("the rrg executable is not built: ") + RRG_CLI);
-  const std::string cmd = "exec " + std::string(RRG_CLI) + " " + args + " > '" + log.string() + "' 2>&1";
+  const std::string cmd = "exec " + rrg_command(args) + " > '" + log.string() + "' 2>&1";
   pid_ = ::fork();
   if (pid_ < 0) throw std::runtime_error("fork failed for: " + cmd);
   if (pid_ == 0) {  // the child becomes `sh -c "exec rrg ..."`, i.e. rrg itself with the redirections
