@@ -1,6 +1,8 @@
 #include "core/planes/global_plane_table.h"
 
 #include <spdlog/fmt/fmt.h>
+#include <spdlog/fmt/ranges.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <cmath>
@@ -44,6 +46,7 @@ std::vector<LocalObservation> GlobalPlaneTable::observe(const PlaneSegmentation&
     out[i].local_id = seg.planes[i].id;
     out[i].plane = seg.planes[i].plane.transformed(T_wc);
     out[i].centroid = T_wc * seg.planes[i].centroid;
+    out[i].same_plane_distance = seg.planes[i].same_plane_distance;
     out[i].points.reserve(size_t(seg.planes[i].pixels / (params_.point_stride * params_.point_stride) + 16));
   }
   const int s = params_.point_stride;
@@ -59,6 +62,19 @@ std::vector<LocalObservation> GlobalPlaneTable::observe(const PlaneSegmentation&
 bool GlobalPlaneTable::geometric_match(const Plane& a, const Eigen::Vector3f& centroid_b) const {
   // Only plane a's normal is compared here; callers pass both orders where symmetry matters.
   return std::abs(a.signed_distance(centroid_b)) <= params_.max_distance;
+}
+
+// The segmenter's coplanarity test (plane_segmentation.cpp, step 3) on two planes of one frame, made
+// one-sided for planes that need not touch: normals within the filter's angle, and the centroid of the
+// plane with fewer points within its same_plane_distance of the plane with more (a small piece's fit
+// may tilt by degrees, which over a metre between the pieces would exceed any noise bound).
+bool GlobalPlaneTable::same_surface(const LocalObservation& a, const LocalObservation& b) const {
+  const float cos_max = std::cos(params_.max_normal_angle_deg * std::numbers::pi_v<float> / 180.0f);
+  const bool a_larger = a.points.size() >= b.points.size();
+  const LocalObservation& large = a_larger ? a : b;
+  const LocalObservation& small = a_larger ? b : a;
+  return a.plane.n.dot(b.plane.n) >= cos_max &&
+         std::abs(large.plane.signed_distance(small.centroid)) < small.same_plane_distance;
 }
 
 std::vector<CandidateScore> GlobalPlaneTable::score(const LocalObservation& obs, int64_t frame) const {
@@ -113,26 +129,62 @@ FrameAssociation GlobalPlaneTable::associate(std::span<const LocalObservation> o
   for (const auto& o : observations) max_local = std::max(max_local, o.local_id);
   out.local_to_global.assign(size_t(max_local) + 1, 0);
   std::vector<int> touched;
+  std::vector<std::pair<int, const LocalObservation*>> claims;  // (instance, a local plane of this frame in it)
+  // An instance already holding a local plane of this frame that is a different surface.
+  const auto taken = [&](int id, const LocalObservation& obs) {
+    for (const auto& [g, other] : claims)
+      if (g == id && !same_surface(*other, obs)) return true;
+    return false;
+  };
   for (const LocalObservation& obs : observations) {
     if (obs.points.size() < 3) continue;
     const std::vector<CandidateScore> scores = score(obs, frame);
     const CandidateScore* best = nullptr;
+    std::vector<int> blocked;  // matching instances held by a different surface of this frame
     for (const CandidateScore& s : scores) {
       if (!s.matched) continue;
-      if (!best || s.overlap > best->overlap || (s.overlap == best->overlap && s.iou > best->iou) ||
-          (s.overlap == best->overlap && s.iou == best->iou && s.gap < best->gap))
+      if (taken(s.global_id, obs)) {
+        blocked.push_back(s.global_id);
+        continue;
+      }
+      // Candidates the observation lies on within its noise come before those only within the
+      // filter's 0.1 m (a wall's piece beside a mirror frame's bar 5 cm in front of it).
+      const bool near = std::abs(planes_[size_t(s.global_id - 1)].plane.signed_distance(obs.centroid)) < obs.same_plane_distance;
+      const bool best_near = best && std::abs(planes_[size_t(best->global_id - 1)].plane.signed_distance(obs.centroid)) < obs.same_plane_distance;
+      if (!best || (near && !best_near) ||
+          (near == best_near && (s.overlap > best->overlap || (s.overlap == best->overlap && s.iou > best->iou) ||
+                                 (s.overlap == best->overlap && s.iou == best->iou && s.gap < best->gap))))
         best = &s;
     }
-    int id = 0;
-    if (best) {
-      id = best->global_id;
-      absorb(planes_[size_t(id - 1)], obs, frame);
-    } else {
+    int id = best ? best->global_id : 0;
+    // Kept off an instance by a different surface and matching no other: a piece of a surface of
+    // this frame (the same surface by the segmenter's test) that was kept off it too joins that piece.
+    if (!best && !blocked.empty())
+      for (const auto& [g, other] : claims)
+        if (same_surface(*other, obs) &&
+            std::any_of(blocked.begin(), blocked.end(), [&](int b) { return seen_apart(g, b); })) {
+          id = g;
+          break;
+        }
+    const bool created = id == 0;
+    if (created) {
       id = create(obs, frame);
       ++out.created;
+    } else {
+      absorb(planes_[size_t(id - 1)], obs, frame);
     }
     out.local_to_global[size_t(obs.local_id)] = id;
     if (std::find(touched.begin(), touched.end(), id) == touched.end()) touched.push_back(id);
+    if (!blocked.empty())
+      spdlog::debug("planes: frame {}: local plane {} ({} points) is another surface than instance(s) {} hold here; {} {}",
+                    frame, obs.local_id, obs.points.size(), fmt::join(blocked, ","), created ? "created" : "took", id);
+    // Seen apart: the instances this plane matched but could not take, and the one it got.
+    for (int g : blocked)
+      if (g != id && !seen_apart(g, id)) {
+        planes_[size_t(g - 1)].apart.push_back(id);
+        planes_[size_t(id - 1)].apart.push_back(g);
+      }
+    claims.emplace_back(id, &obs);
   }
   merge_pass(touched, out);
   for (int& id : out.local_to_global) id = id > 0 ? canonical(id) : 0;
@@ -149,6 +201,7 @@ void GlobalPlaneTable::merge_pass(std::span<const int> touched, FrameAssociation
         const GlobalPlane& ga = planes_[size_t(a - 1)];
         if (!other.alive || other.id == a || ga.plane.n.dot(other.plane.n) < cos_max) continue;
         if (!geometric_match(ga.plane, other.centroid) || !geometric_match(other.plane, ga.centroid)) continue;
+        if (seen_apart(a, other.id)) continue;
         // Both footprints in a's basis; the smaller one's cells inside the larger one, dilated.
         Footprint b_in_a(ga.footprint.basis(), params_.cell_size);
         b_in_a.merge(other.footprint);
@@ -183,9 +236,18 @@ bool GlobalPlaneTable::merge(int a, int b) {
   k.first_seen = std::min(k.first_seen, g.first_seen);
   k.last_seen = std::max(k.last_seen, g.last_seen);
   k.observations += g.observations;
+  k.apart.insert(k.apart.end(), g.apart.begin(), g.apart.end());
+  g.apart.clear();
   g.alive = false;
   parent_[size_t(gone)] = kept;
   return true;
+}
+
+bool GlobalPlaneTable::seen_apart(int a, int b) const {
+  const GlobalPlane* ga = find(a);
+  const int rb = canonical(b);
+  if (!ga || ga->id == rb) return false;
+  return std::any_of(ga->apart.begin(), ga->apart.end(), [&](int x) { return canonical(x) == rb; });
 }
 
 int GlobalPlaneTable::canonical(int id) const {

@@ -5,8 +5,14 @@
 //    the local plane's centroid <= 0.1 m;
 //  - footprint tests in the candidate's plane basis (grid 0.05 m): cell overlap (1-cell dilation)
 //    > 0.05, bounding-box IoU > 0.02, or bounding-box gap < 0.10 m for an instance seen within the
-//    last `recent_frames` frames; among matching candidates the highest overlap wins; no match
-//    creates a new instance;
+//    last `recent_frames` frames; among matching candidates the highest overlap wins (ours: those
+//    whose plane the observation's centroid lies on within LocalPlane::same_plane_distance first);
+//    no match creates a new instance;
+//  - one frame, one surface per instance (ours): two local planes of one frame that the segmenter
+//    keeps apart as different surfaces (LocalPlane::same_plane_distance) do not share an instance;
+//    the larger keeps it, the other takes its next match or a new instance, and the two instances
+//    are recorded as seen apart, so the merge pass never joins them (a mirror frame's bar 3.5 cm in
+//    front of the mirror, a bookshelf's back 2.5 cm in front of its wall: both within the 0.1 m filter);
 //  - union-find merges of instances recognised as one physical plane (the lower id absorbs the
 //    higher: moments, plane parameters, footprint and bounding box are unified), and the id remap
 //    table (id -> canonical id) used by TSDF fusion and raycasting.
@@ -53,6 +59,7 @@ struct GlobalPlane {
   int64_t first_seen = 0, last_seen = 0;  // frame indices
   int observations = 0;                // frames it was matched in
   bool alive = true;                   // false once absorbed by a merge
+  std::vector<int> apart;              // instances seen in one frame as a different surface (ids as recorded)
 };
 
 // One local plane of one frame, in the world frame.
@@ -61,6 +68,7 @@ struct LocalObservation {
   Plane plane;                         // world frame
   Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
   std::vector<Eigen::Vector3f> points; // world frame (subsampled pixels)
+  float same_plane_distance = 0.01f;   // LocalPlane::same_plane_distance
 };
 
 // How one local plane compared with one candidate (for logs and tests).
@@ -92,6 +100,8 @@ class GlobalPlaneTable {
 
   // Union-find merge (lower id absorbs higher); returns false when already one instance.
   bool merge(int a, int b);
+  // Whether instances a and b were seen in one frame as different surfaces (the merge pass skips them).
+  bool seen_apart(int a, int b) const;
   int canonical(int id) const;                   // find(); ids out of range map to themselves
   std::vector<int32_t> remap_table() const;      // [next id], id -> canonical id, [0] = 0
   // Local plane map -> global plane map I_k^g (canonical ids, 0 = none).
@@ -104,6 +114,7 @@ class GlobalPlaneTable {
  private:
   friend struct PlaneStateIo;  // snapshots (plane_state_io.h)
   bool geometric_match(const Plane& a, const Eigen::Vector3f& centroid_b) const;
+  bool same_surface(const LocalObservation& a, const LocalObservation& b) const;
   void absorb(GlobalPlane& into, const LocalObservation& obs, int64_t frame);
   int create(const LocalObservation& obs, int64_t frame);
   void merge_pass(std::span<const int> touched, FrameAssociation& out);

@@ -160,8 +160,7 @@ std::vector<PlaneFit> merge_regions(const CellGrid& g, const PlaneSegmentationPa
   const float cos_merge = cos_deg(p.merge_angle_deg);
   auto agree = [&](const PlaneFit& a, const PlaneFit& b) {
     if (!a.valid || !b.valid || a.plane.n.dot(b.plane.n) < cos_merge) return false;
-    const float ta = std::max(p.merge_distance, 3.0f * p.sigma(a.centroid.z()));
-    const float tb = std::max(p.merge_distance, 3.0f * p.sigma(b.centroid.z()));
+    const float ta = p.merge_tolerance(a.centroid.z()), tb = p.merge_tolerance(b.centroid.z());
     return std::abs(a.plane.signed_distance(b.centroid)) < tb && std::abs(b.plane.signed_distance(a.centroid)) < ta;
   };
   for (bool changed = true; changed;) {
@@ -318,6 +317,7 @@ PlaneSegmentation segment_planes(const DepthImage& depth, const Intrinsics& K, c
     lp.centroid = f.centroid;
     lp.pixels = moments[size_t(r)].count();
     lp.rms = std::sqrt(f.mse);
+    lp.same_plane_distance = params.merge_tolerance(f.centroid.z());
     new_id[size_t(r)] = lp.id;
     out.planes.push_back(lp);
   }

@@ -46,6 +46,8 @@ struct PlaneSegmentationParams {
   float sigma(float z) const { return std::max(sigma_min, sigma_k * z * z); }
   float noise_sigma(float z) const { return noise_a + noise_b * (z - noise_z0) * (z - noise_z0); }
   float planar_rms(float z) const { return std::max(sigma(z), planar_sigmas * noise_sigma(z)); }
+  // Coplanarity of two regions (step 3, and LocalPlane::same_plane_distance): centroid-to-plane distance.
+  float merge_tolerance(float z) const { return std::max(merge_distance, 3.0f * sigma(z)); }
   float refine_distance(float z) const {
     return std::max(min_refine_distance, refine_distance_sigmas * std::max(sigma(z), noise_sigma(z)));
   }

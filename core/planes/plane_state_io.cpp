@@ -25,7 +25,7 @@ Box2 get_box(io::ByteReader& r) {
 }  // namespace
 
 void PlaneStateIo::write(io::ByteWriter& w, const PlaneIdentifier& id) {
-  w.put<uint32_t>(1);  // format version
+  w.put<uint32_t>(2);  // format version (2: GlobalPlane::apart)
   w.put<int64_t>(id.window_);
   const GlobalPlaneTable& t = id.table_;
   w.put<uint64_t>(t.planes_.size());
@@ -46,6 +46,7 @@ void PlaneStateIo::write(io::ByteWriter& w, const PlaneIdentifier& id) {
     w.put<int64_t>(g.first_seen), w.put<int64_t>(g.last_seen);
     w.put<int32_t>(g.observations);
     w.put<uint8_t>(g.alive);
+    w.put_vector(std::vector<int32_t>(g.apart.begin(), g.apart.end()));
   }
   std::vector<int32_t> parent(t.parent_.begin(), t.parent_.end());
   w.put_vector(parent);
@@ -61,7 +62,8 @@ void PlaneStateIo::write(io::ByteWriter& w, const PlaneIdentifier& id) {
 }
 
 void PlaneStateIo::read(io::ByteReader& r, PlaneIdentifier& id) {
-  if (const auto version = r.get<uint32_t>(); version != 1)
+  const auto version = r.get<uint32_t>();
+  if (version != 1 && version != 2)
     throw std::runtime_error(r.what() + ": unsupported plane state version " + std::to_string(version));
   id.window_ = r.get<int64_t>();
   GlobalPlaneTable& t = id.table_;
@@ -84,6 +86,11 @@ void PlaneStateIo::read(io::ByteReader& r, PlaneIdentifier& id) {
     g.first_seen = r.get<int64_t>(), g.last_seen = r.get<int64_t>();
     g.observations = r.get<int32_t>();
     g.alive = r.get<uint8_t>() != 0;
+    if (version >= 2)
+      for (int32_t x : r.get_vector<int32_t>()) {
+        if (x < 1 || uint64_t(x) > n) throw std::runtime_error(r.what() + ": plane id out of range in a seen-apart list");
+        g.apart.push_back(x);
+      }
     if (g.id != int(i) + 1) throw std::runtime_error(r.what() + ": plane ids are not 1..n");
     t.planes_.push_back(std::move(g));
   }

@@ -32,6 +32,9 @@ struct LocalPlane {
   Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
   int64_t pixels = 0;                  // labelled pixels
   float rms = 0.0f;                    // RMS point-to-plane distance of those pixels, metres
+  // The segmenter's coplanarity tolerance at this plane's depth, max(merge_distance, 3 σ(z)): two
+  // planes of one depth map are one surface only when each centroid lies this close to the other.
+  float same_plane_distance = 0.01f;
 };
 
 struct PlaneSegmentation {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 namespace rrg {
 namespace {
@@ -161,6 +162,93 @@ TEST(GlobalPlaneTable, MergePassJoinsInstancesThatTurnOutToBeOnePlane) {
   EXPECT_EQ(a.merges[0], std::make_pair(1, 2));
   EXPECT_EQ(a.local_to_global[1], 1);
   EXPECT_EQ(t.canonical(2), 1);
+}
+
+// A mirror and its frame's bar 3.5 cm in front of it, beside it: within the 0.1 m filter of each
+// other, and inside each other's dilated footprints, so by overlap alone the bar takes the mirror's
+// instance, and the merge pass would join a bar instance to the mirror's.
+TEST(GlobalPlaneTable, OneFrameKeepsDifferentSurfacesInDifferentInstances) {
+  const auto frame_of = [](float same_plane_distance) {
+    LocalObservation mirror = patch(1, 0, 1, 0, 1), bar = patch(2, 1.0f, 1.08f, 0, 1, 0.035f);
+    mirror.same_plane_distance = bar.same_plane_distance = same_plane_distance;
+    return std::vector<LocalObservation>{mirror, bar};
+  };
+  {
+    GlobalPlaneTable t;
+    associate_one(t, patch(1, 0, 1, 0, 1), 0);  // the mirror alone first: instance 1
+    // Seen together at ~2 m, where the segmenter's coplanarity tolerance is 1.2 cm: two surfaces.
+    const auto both = frame_of(0.012f);
+    const FrameAssociation a = t.associate(both, 10);
+    EXPECT_EQ(a.local_to_global[1], 1);
+    EXPECT_EQ(a.local_to_global[2], 2);
+    EXPECT_TRUE(a.merges.empty());
+    EXPECT_TRUE(t.seen_apart(1, 2));
+    EXPECT_TRUE(t.seen_apart(2, 1));
+    // Later the bar alone: its own instance (same overlap, larger IoU), and no merge into the
+    // mirror although it lies inside the mirror's dilated footprint.
+    LocalObservation bar = both[1];
+    bar.local_id = 1;
+    const auto scores = t.score(bar, 20);
+    ASSERT_EQ(scores.size(), 2u);
+    EXPECT_TRUE(scores[0].matched && scores[1].matched);
+    EXPECT_EQ(associate_one(t, bar, 20), 2);
+    EXPECT_EQ(t.live_ids(), (std::vector<int>{1, 2}));
+  }
+  {
+    // At ~4 m the tolerance (3 σ = 4.8 cm) covers 3.5 cm: one surface, as before the rule.
+    GlobalPlaneTable t;
+    associate_one(t, patch(1, 0, 1, 0, 1), 0);
+    const auto both = frame_of(0.048f);
+    const FrameAssociation a = t.associate(both, 10);
+    EXPECT_EQ(a.local_to_global[1], 1);
+    EXPECT_EQ(a.local_to_global[2], 1);
+    EXPECT_FALSE(t.seen_apart(1, 2));
+  }
+}
+
+// One surface split in two by an occluder: both pieces keep the instance, and seen-apart instances
+// stay joinable by an explicit merge's bookkeeping (the lists follow the kept instance).
+TEST(GlobalPlaneTable, PiecesOfOneSurfaceShareTheInstance) {
+  GlobalPlaneTable t;
+  associate_one(t, patch(1, 0, 2, 0, 1), 0);
+  const LocalObservation pieces[] = {patch(1, 0, 0.9f, 0, 1), patch(2, 1.1f, 2, 0, 1, 0.004f)};
+  const FrameAssociation a = t.associate(pieces, 10);
+  EXPECT_EQ(a.local_to_global[1], 1);
+  EXPECT_EQ(a.local_to_global[2], 1);
+  EXPECT_EQ(t.live_ids().size(), 1u);
+
+  GlobalPlaneTable u;
+  associate_one(u, patch(1, 0, 1, 0, 1), 0);                       // 1
+  associate_one(u, patch(1, 3, 4, 0, 1), 0);                       // 2
+  LocalObservation near = patch(1, 5, 6, 0, 1), front = patch(2, 5, 6, 0, 1, 0.05f);
+  near.same_plane_distance = front.same_plane_distance = 0.01f;
+  const LocalObservation frame[] = {near, front};
+  const FrameAssociation b = u.associate(frame, 0);                // 3 and 4, seen apart
+  ASSERT_EQ(b.local_to_global[1], 3);
+  ASSERT_EQ(b.local_to_global[2], 4);
+  EXPECT_TRUE(u.seen_apart(3, 4));
+  EXPECT_TRUE(u.merge(2, 3));                                      // 2 absorbs 3 and its list
+  EXPECT_TRUE(u.seen_apart(2, 4));
+  EXPECT_TRUE(u.seen_apart(4, 3));
+  EXPECT_FALSE(u.seen_apart(1, 4));
+}
+
+// Among matching instances, those the observation lies on within its noise come first: a piece of
+// wall seen where a bar 5 cm in front of it has its instance overlaps the bar's footprint best.
+TEST(GlobalPlaneTable, InstancesWithinTheNoiseComeBeforeBetterOverlap) {
+  GlobalPlaneTable t;
+  associate_one(t, patch(1, 0, 1, 0, 1), 0);                       // 1: wall, z = 0
+  LocalObservation wall = patch(1, 0, 1, 0, 1), bar = patch(2, 1.0f, 1.1f, 0, 1, 0.05f);
+  wall.same_plane_distance = bar.same_plane_distance = 0.012f;
+  const LocalObservation both[] = {wall, bar};
+  ASSERT_EQ(t.associate(both, 10).local_to_global[2], 2);          // 2: bar, z = 5 cm
+  LocalObservation piece = patch(1, 1.0f, 1.1f, 0, 1);             // wall beside the bar, on z = 0
+  piece.same_plane_distance = 0.012f;
+  const auto scores = t.score(piece, 20);
+  ASSERT_EQ(scores.size(), 2u);
+  ASSERT_TRUE(scores[0].matched && scores[1].matched);
+  EXPECT_GT(scores[1].overlap, scores[0].overlap);                 // the bar's footprint fits better
+  EXPECT_EQ(associate_one(t, piece, 20), 1);                       // but the wall is the surface
 }
 
 TEST(GlobalPlaneTable, ObserveTransformsPlanesToWorld) {
