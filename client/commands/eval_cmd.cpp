@@ -3,6 +3,8 @@
 #include "client/commands/command.h"
 #include "core/eval/image_set.h"
 #include "core/eval/mesh_metrics.h"
+#include "core/eval/observed_mesh_metrics.h"
+#include "core/io/dataset.h"
 #include "core/eval/trajectory_metrics.h"
 #include "core/io/ply.h"
 #include "core/io/trajectory.h"
@@ -136,6 +138,7 @@ void run_images(const ImagesOptions& o) {
 // ---- mesh ----------------------------------------------------------------------------------------
 struct MeshOptions {
   std::string est, ref;
+  std::string observed_by;  // dataset whose frames (ground-truth poses) define the observed surface
   eval::MeshEvalParams params;
   bool json = false;
 };
@@ -148,15 +151,39 @@ void run_mesh(const MeshOptions& o) {
   progress(o.json, "eval mesh: {} / {} vertices, sampling {} points each, nearest neighbours", est.vertices.size(),
            ref.vertices.size(), o.params.samples);
   eval::MeshMetrics m;
+  std::optional<eval::ObservedMeshMetrics> seen;  // with --observed-by
   try {
-    m = eval::evaluate_mesh(est, ref, o.params);
+    if (o.observed_by.empty()) {
+      m = eval::evaluate_mesh(est, ref, o.params);
+    } else {
+      const auto dataset = io::open_dataset(o.observed_by);
+      if (!dataset->has_ground_truth())
+        throw std::runtime_error("--observed-by " + o.observed_by + " has no ground-truth poses");
+      seen = eval::evaluate_mesh_observed(est, ref, *dataset, 0, o.params, eval::kObservedDepthTolerance,
+                                          [&](size_t done, size_t total) {
+                                            if (done % 50 == 0 || done == total)
+                                              progress(o.json, "eval mesh: observed surface, frame {}/{}", done, total);
+                                          });
+      m = seen->whole;
+      if (seen->observed) {
+        m.completion_cm = seen->observed->completion_cm;
+        m.completion_ratio = seen->observed->completion_ratio;
+        m.ref_samples = seen->observed->ref_samples;
+      }
+    }
   } catch (const std::exception& e) {
     throw std::runtime_error(o.est + " vs " + o.ref + ": " + e.what());
   }
+  if (seen && !seen->observed) throw std::runtime_error("--observed-by " + o.observed_by + ": no frame observes " + o.ref);
   if (o.json) {
     json j = {{"est", o.est}, {"ref", o.ref}, {"est_samples", m.est_samples}, {"ref_samples", m.ref_samples},
               {"threshold_m", m.threshold_m}, {"accuracy_cm", m.accuracy_cm}, {"completion_cm", m.completion_cm},
               {"accuracy_ratio", m.accuracy_ratio}, {"completion_ratio", m.completion_ratio}};
+    if (seen) {
+      j["observed_by"] = o.observed_by;
+      j["observed_fraction"] = seen->observed_fraction;
+      j["completion_whole_cm"] = seen->whole.completion_cm;
+    }
     std::cout << j.dump(2) << "\n";
     return;
   }
@@ -167,6 +194,11 @@ void run_mesh(const MeshOptions& o) {
   row("completion (cm)", fixed2(m.completion_cm));
   row("accuracy ratio (< " + tau + ", %)", fixed2(100.0 * m.accuracy_ratio));
   row("completion ratio (< " + tau + ", %)", fixed2(100.0 * m.completion_ratio));
+  if (seen) {
+    row("completion over", fmt::format("the {:.1f}% of the reference observed by {} ({} frames)",
+                                       100.0 * seen->observed_fraction, o.observed_by, seen->frames));
+    row("completion, all ref. (cm)", fixed2(seen->whole.completion_cm));
+  }
 }
 
 // A flag value that must be a number > 0 (or >= 0): CLI11's own range check prints DBL_MAX.
@@ -223,6 +255,10 @@ void register_eval_command(CLI::App& app) {
       ->capture_default_str()->check(number_above_zero(false));
   mesh->add_option("--threshold", mesh_opts->params.threshold, "ratio threshold, metres")
       ->capture_default_str()->check(number_above_zero(false));
+  mesh->add_option("--observed-by", mesh_opts->observed_by,
+                   "dataset with ground-truth poses: completion over the reference surface its frames observed "
+                   "(depth within 5 cm, facing the camera), as rrg run scores")
+      ->check(CLI::ExistingDirectory);
   mesh->add_flag("--json", mesh_opts->json, "print JSON instead of a table");
   mesh->callback([mesh_opts] { run_mesh(*mesh_opts); });
 }

@@ -6,10 +6,17 @@
 
 namespace rrg::eval {
 
-ObservedSurface::ObservedSurface(std::span<const Eigen::Vector3f> points, double tolerance_m)
-    : points_(points.begin(), points.end()), seen_(points.size(), 0), tolerance_m_(tolerance_m) {
+ObservedSurface::ObservedSurface(std::span<const Eigen::Vector3f> points, double tolerance_m,
+                                 std::span<const Eigen::Vector3f> normals)
+    : points_(points.begin(), points.end()),
+      normals_(normals.begin(), normals.end()),
+      seen_(points.size(), 0),
+      tolerance_m_(tolerance_m) {
   if (!(tolerance_m > 0.0) || !std::isfinite(tolerance_m))
     throw std::invalid_argument("observed surface: the depth tolerance must be a positive number of metres");
+  if (!normals_.empty() && normals_.size() != points_.size())
+    throw std::invalid_argument("observed surface: " + std::to_string(normals_.size()) + " normals for " +
+                                std::to_string(points_.size()) + " points");
 }
 
 void ObservedSurface::observe(const DepthImage& depth, const Intrinsics& K, const Eigen::Isometry3d& T_wc) {
@@ -18,11 +25,14 @@ void ObservedSurface::observe(const DepthImage& depth, const Intrinsics& K, cons
                                 std::to_string(depth.height()) + " differs from the intrinsics' " +
                                 std::to_string(K.width) + "x" + std::to_string(K.height));
   const Eigen::Isometry3f T_cw = T_wc.inverse().cast<float>();
+  const Eigen::Vector3f eye = T_wc.translation().cast<float>();
+  const bool facing_test = !normals_.empty();
   const auto n = static_cast<std::int64_t>(points_.size());
   const float tol = float(tolerance_m_);
 #pragma omp parallel for schedule(static) if (n >= 16384)
   for (std::int64_t i = 0; i < n; ++i) {
     if (seen_[size_t(i)]) continue;
+    if (facing_test && normals_[size_t(i)].dot(eye - points_[size_t(i)]) <= 0.0f) continue;  // its back
     const Eigen::Vector3f p = T_cw * points_[size_t(i)];
     if (!(p.z() > 0.0f)) continue;
     const Eigen::Vector2f uv = K.project(p);

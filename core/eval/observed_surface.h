@@ -4,7 +4,9 @@
 // mesh evaluations). A sample q counts as observed when at least one frame saw it: q projects to
 // a pixel inside the image, in front of the camera, and that pixel's measured depth lies within
 // `tolerance_m` of q's depth, so q is the first surface along the pixel's ray and not a surface
-// hidden behind it (or outside the sensor's range, where the depth is 0).
+// hidden behind it (or outside the sensor's range, where the depth is 0); and, when the samples carry
+// their surface's outward normals, q's side faces the camera: the back of a shelf board or of a panel
+// against a wall lies within the tolerance of the face the sensor measured, yet no camera saw it.
 #include "core/common/camera.h"
 #include "core/common/image.h"
 
@@ -19,8 +21,10 @@ namespace rrg::eval {
 
 class ObservedSurface {
  public:
-  // tolerance_m must be positive (throws std::invalid_argument).
-  ObservedSurface(std::span<const Eigen::Vector3f> points, double tolerance_m);
+  // tolerance_m must be positive; normals empty (no facing test) or one per point (throws
+  // std::invalid_argument otherwise).
+  ObservedSurface(std::span<const Eigen::Vector3f> points, double tolerance_m,
+                  std::span<const Eigen::Vector3f> normals = {});
 
   // Marks the samples frame (depth in metres, 0 = no measurement; K; camera-to-world T_wc) observes.
   // Throws std::invalid_argument when the depth image and K disagree in size.
@@ -32,6 +36,7 @@ class ObservedSurface {
 
  private:
   std::vector<Eigen::Vector3f> points_;
+  std::vector<Eigen::Vector3f> normals_;  // [points_] or empty
   std::vector<uint8_t> seen_;
   double tolerance_m_;
 };

@@ -41,7 +41,7 @@ double surface_area(const TriangleMesh& mesh) {
   return area;
 }
 
-std::vector<Eigen::Vector3f> sample_surface(const TriangleMesh& mesh, size_t n, uint64_t seed) {
+OrientedSamples sample_surface_oriented(const TriangleMesh& mesh, size_t n, uint64_t seed) {
   try {
     mesh.validate();
   } catch (const std::runtime_error& e) {
@@ -53,21 +53,27 @@ std::vector<Eigen::Vector3f> sample_surface(const TriangleMesh& mesh, size_t n, 
   std::vector<double> cdf(mesh.triangles.size());
   double total = 0.0;
   for (size_t k = 0; k < mesh.triangles.size(); ++k) cdf[k] = (total += triangle_area(mesh, mesh.triangles[k]));
-  if (!(total > 0.0) || !std::isfinite(total)) return mesh.vertices;
+  if (!(total > 0.0) || !std::isfinite(total)) return {mesh.vertices, {}};
 
   SplitMix64 rng(seed);
-  std::vector<Eigen::Vector3f> points(n);
+  OrientedSamples out;
+  out.points.resize(n);
+  out.normals.resize(n);
   for (size_t i = 0; i < n; ++i) {
     const double u = rng.uniform() * total;
     const size_t k = std::min(size_t(std::upper_bound(cdf.begin(), cdf.end(), u) - cdf.begin()), cdf.size() - 1);
     const Eigen::Vector3i& f = mesh.triangles[k];
+    const Eigen::Vector3d a = mesh.vertices[f[0]].cast<double>(), b = mesh.vertices[f[1]].cast<double>(),
+                          c = mesh.vertices[f[2]].cast<double>();
     const double s = std::sqrt(rng.uniform()), r2 = rng.uniform();
-    const Eigen::Vector3d p = (1.0 - s) * mesh.vertices[f[0]].cast<double>() +
-                              s * (1.0 - r2) * mesh.vertices[f[1]].cast<double>() +
-                              s * r2 * mesh.vertices[f[2]].cast<double>();
-    points[i] = p.cast<float>();
+    out.points[i] = ((1.0 - s) * a + s * (1.0 - r2) * b + s * r2 * c).cast<float>();
+    out.normals[i] = (b - a).cross(c - a).normalized().cast<float>();  // area > 0: the triangle was drawn
   }
-  return points;
+  return out;
+}
+
+std::vector<Eigen::Vector3f> sample_surface(const TriangleMesh& mesh, size_t n, uint64_t seed) {
+  return sample_surface_oriented(mesh, n, seed).points;
 }
 
 }  // namespace rrg::eval

@@ -20,4 +20,13 @@ double surface_area(const TriangleMesh& mesh);
 // std::invalid_argument when the mesh has no vertices or fails validate().
 std::vector<Eigen::Vector3f> sample_surface(const TriangleMesh& mesh, size_t n, uint64_t seed);
 
+// The same points (same seed, same stream) with the unit normal of the triangle each lies on, on
+// the side its winding gives (right hand: (b − a) × (c − a)), i.e. the outward side of a closed or
+// consistently wound mesh. A point cloud yields its vertices and no normals (normals empty).
+struct OrientedSamples {
+  std::vector<Eigen::Vector3f> points;
+  std::vector<Eigen::Vector3f> normals;  // [points.size()] or empty
+};
+OrientedSamples sample_surface_oriented(const TriangleMesh& mesh, size_t n, uint64_t seed);
+
 }  // namespace rrg::eval

@@ -2,8 +2,7 @@
 
 #include "core/eval/image_metrics.h"
 #include "core/eval/mesh_metrics.h"
-#include "core/eval/observed_surface.h"
-#include "core/eval/surface_sampling.h"
+#include "core/eval/observed_mesh_metrics.h"
 #include "core/eval/trajectory_metrics.h"
 #include "core/io/atomic_file.h"
 #include "core/io/draco_mesh.h"
@@ -28,10 +27,6 @@
 namespace rrg {
 namespace {
 
-// A ground-truth surface sample counts as observed by a frame when the frame's measured depth at
-// its pixel is within this of its own depth: wide enough for Kinect-like noise (σ ≈ 2.5 cm at 4 m),
-// narrow against surfaces hidden behind the one seen.
-constexpr double kObservedDepthTolerance = 0.05;
 
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
@@ -309,27 +304,17 @@ RunResult run_dataset(const RunOptions& o) {
   if (o.write_mesh || synth) mesh = session.mesh();
   if (synth && std::filesystem::exists(io::synth_scene_file(o.dataset, "mesh_gt.ply")) && !mesh.triangles.empty()) {
     const TriangleMesh gt = io::read_ply_mesh(io::synth_scene_file(o.dataset, "mesh_gt.ply"));
-    const eval::MeshEvalParams mp;
-    const std::vector<Eigen::Vector3f> est_points = eval::sample_surface(mesh, mp.samples, mp.seed);
-    const std::vector<Eigen::Vector3f> gt_points = eval::sample_surface(gt, mp.samples, mp.seed + 1);
-    // The surface the run could have seen: every frame's measured depth at its ground-truth pose.
-    eval::ObservedSurface seen(gt_points, kObservedDepthTolerance);
-    for (size_t i = 0; i < n; ++i) {
-      const io::Frame f = dataset->load(i);
-      if (f.T_wc_gt) seen.observe(f.depth, dataset->intrinsics(), *f.T_wc_gt);
-    }
-    const eval::MeshMetrics whole = eval::evaluate_point_sets(est_points, gt_points, mp.threshold);
-    m.accuracy_cm = whole.accuracy_cm;
-    m.completion_whole_cm = whole.completion_cm;
-    m.observed_fraction = double(seen.observed()) / double(seen.size());
-    if (seen.observed() > 0) {
-      const eval::MeshMetrics observed = eval::evaluate_point_sets(est_points, seen.observed_points(), mp.threshold);
-      m.completion_cm = observed.completion_cm;
-      m.completion_ratio = observed.completion_ratio;
+    const eval::ObservedMeshMetrics g = eval::evaluate_mesh_observed(mesh, gt, *dataset, n);
+    m.accuracy_cm = g.whole.accuracy_cm;
+    m.completion_whole_cm = g.whole.completion_cm;
+    m.observed_fraction = g.observed_fraction;
+    if (g.observed) {
+      m.completion_cm = g.observed->completion_cm;
+      m.completion_ratio = g.observed->completion_ratio;
     }
     spdlog::debug("run: {:.1f}% of the ground-truth surface observed; completion {} cm there, {:.2f} cm over the whole mesh",
                   100.0 * *m.observed_fraction, m.completion_cm ? fmt::format("{:.2f}", *m.completion_cm) : "-",
-                  whole.completion_cm);
+                  g.whole.completion_cm);
   }
 
   // --- files ---

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <fstream>
 #include <sstream>
 
 namespace rrg::eval {
@@ -136,6 +137,54 @@ TEST(EvalCli, MeshOfTwoParallelSquaresPrintsTwoCentimetres) {
   r = run_rrg("eval mesh --est " + q(dir / "missing.ply") + " --ref " + q(dir / "gt.ply"));
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("missing.ply"), std::string::npos) << r.output;
+}
+
+// `--observed-by`: one frame (identity pose, flat depth of 2 m over 40x30 px) sees the front of a
+// 1 m² panel 2 cm thick; the reference also holds the panel's back and a square out of view, each
+// 1 m². The estimate is the front alone: completion over what the frame observed is the sampling
+// floor, over the whole reference it is not.
+TEST(EvalCli, MeshObservedByADatasetScoresTheSurfaceItsFramesSaw) {
+  TempDir dir("eval-cli");
+  const std::filesystem::path seq = dir / "seq";
+  std::filesystem::create_directories(seq);
+  std::ofstream(seq / "rgb.txt") << "# timestamp filename\n0.000000 rgb/000000.png\n";
+  std::ofstream(seq / "depth.txt") << "# timestamp filename\n0.000000 depth/000000.png\n";
+  std::ofstream(seq / "groundtruth.txt") << "# timestamp tx ty tz qx qy qz qw\n0.000000 0 0 0 0 0 0 1\n";
+  std::ofstream(seq / "camera.json") << R"({"width":40,"height":30,"fx":20,"fy":20,"cx":19.5,"cy":14.5,"depth_scale":5000})";
+  io::write_color_png(seq / "rgb/000000.png", ColorImage(40, 30, Color(0.5f, 0.5f, 0.5f)));
+  io::write_depth_png(seq / "depth/000000.png", DepthImage(40, 30, 2.0f), 5000.0f);
+  const auto flipped = [](TriangleMesh m) {  // the other winding: normal −z, towards the camera
+    for (auto& f : m.triangles) std::swap(f[1], f[2]);
+    return m;
+  };
+  const TriangleMesh front = flipped(test::square(-0.5, -0.5, 1, 1, 2.0));
+  const TriangleMesh back = test::square(-0.5, -0.5, 1, 1, 2.02), away = flipped(test::square(10, 0, 1, 1, 2.0));
+  TriangleMesh ref;
+  for (const TriangleMesh* m : {&front, &back, &away}) {
+    const int base = int(ref.vertices.size());
+    ref.vertices.insert(ref.vertices.end(), m->vertices.begin(), m->vertices.end());
+    for (const auto& f : m->triangles) ref.triangles.push_back(f + Eigen::Vector3i::Constant(base));
+  }
+  io::write_ply_mesh(dir / "est.ply", front);
+  io::write_ply_mesh(dir / "gt.ply", ref);
+  const std::string cmd = "eval mesh --json --est " + q(dir / "est.ply") + " --ref " + q(dir / "gt.ply");
+  auto r = run_rrg(cmd + " --observed-by " + q(seq));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  auto j = nlohmann::json::parse(r.output);
+  EXPECT_NEAR(j.at("observed_fraction").get<double>(), 1.0 / 3.0, 0.01);  // the front only, not its back
+  EXPECT_LT(j.at("completion_cm").get<double>(), 0.3);
+  EXPECT_EQ(j.at("completion_ratio"), 1.0);
+  EXPECT_GT(j.at("completion_whole_cm").get<double>(), 100.0);  // the out-of-view square, ~10 m away
+  r = run_rrg(cmd);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  j = nlohmann::json::parse(r.output);
+  EXPECT_GT(j.at("completion_cm").get<double>(), 100.0);
+  EXPECT_FALSE(j.contains("observed_fraction"));
+
+  r = run_rrg("eval mesh --est " + q(dir / "est.ply") + " --ref " + q(dir / "gt.ply") + " --observed-by " +
+              q(dir / "nowhere"));
+  EXPECT_NE(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("nowhere"), std::string::npos) << r.output;
 }
 
 }  // namespace

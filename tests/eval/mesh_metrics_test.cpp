@@ -71,6 +71,28 @@ TEST(SurfaceSampling, UniformByAreaDeterministicAndOnTheSurface) {
   EXPECT_NEAR(mean_x_big / double(N - on_small), 1.5, 0.025);
 }
 
+TEST(SurfaceSampling, OrientedSamplesAreTheSamePointsWithTheirWindingNormals) {
+  // The unit square (winding +z) and the same square at z = 1 wound the other way (normal −z).
+  TriangleMesh m = square(0, 0, 1, 1, 0);
+  m.vertices.insert(m.vertices.end(), {Eigen::Vector3f(0, 0, 1), Eigen::Vector3f(1, 0, 1), Eigen::Vector3f(1, 1, 1)});
+  m.triangles.push_back(Eigen::Vector3i(4, 6, 5));
+  const OrientedSamples o = sample_surface_oriented(m, 5000, 3);
+  EXPECT_EQ(o.points, sample_surface(m, 5000, 3));
+  ASSERT_EQ(o.normals.size(), o.points.size());
+  size_t up = 0, down = 0;
+  for (size_t i = 0; i < o.points.size(); ++i) {
+    const bool top = o.points[i].z() == 1.0f;
+    const Eigen::Vector3f expected(0.0f, 0.0f, top ? -1.0f : 1.0f);
+    ASSERT_TRUE(o.normals[i].isApprox(expected, 1e-6f)) << i;
+    (top ? down : up) += 1;
+  }
+  EXPECT_GT(up, 0u);
+  EXPECT_GT(down, 0u);
+  TriangleMesh cloud;
+  cloud.vertices = {Eigen::Vector3f(1, 2, 3)};
+  EXPECT_TRUE(sample_surface_oriented(cloud, 10, 0).normals.empty());
+}
+
 TEST(SurfaceSampling, PointCloudsUseTheirVertices) {
   TriangleMesh cloud;
   cloud.vertices = {Eigen::Vector3f(1, 2, 3), Eigen::Vector3f(4, 5, 6)};

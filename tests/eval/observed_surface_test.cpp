@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <stdexcept>
 #include <vector>
 
@@ -72,10 +74,38 @@ TEST(ObservedSurface, AnotherFrameRevealsWhatTheFirstMissed) {
   EXPECT_EQ(seen.observed(), 1u);
 }
 
+// A panel 2 cm thick at z = 1.98 .. 2.0 m in front of the wall (camera at the origin looking +z):
+// its front face (normal −z, towards the camera) is measured; its back face, 2 cm behind that,
+// passes the 5 cm depth test but faces away from the camera, so with normals it is not observed.
+TEST(ObservedSurface, FacesTurnedAwayFromTheCameraAreNotObserved) {
+  const Intrinsics K = camera();
+  DepthImage d(100, 80, 1.98f);
+  const Eigen::Vector3f front = K.unproject(30.0f, 30.0f, 1.98f), back = K.unproject(30.0f, 30.0f, 2.0f);
+  const std::vector<Eigen::Vector3f> pts = {front, back};
+  const std::vector<Eigen::Vector3f> normals = {-Eigen::Vector3f::UnitZ(), Eigen::Vector3f::UnitZ()};
+  ObservedSurface depth_only(pts, 0.05);
+  depth_only.observe(d, K, Eigen::Isometry3d::Identity());
+  EXPECT_EQ(depth_only.observed(), 2u);
+  ObservedSurface facing(pts, 0.05, normals);
+  facing.observe(d, K, Eigen::Isometry3d::Identity());
+  ASSERT_EQ(facing.observed(), 1u);
+  EXPECT_TRUE(facing.observed_points()[0].isApprox(front));
+  // Seen from behind the panel (camera at z = 4 m looking −z), the back face is the visible one.
+  Eigen::Isometry3d T_wc = Eigen::Isometry3d::Identity();
+  T_wc.linear() = Eigen::AngleAxisd(3.14159265358979, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  T_wc.translation() = Eigen::Vector3d(0.0, 0.0, 4.0);
+  const Eigen::Vector3f back_cam = (T_wc.inverse().cast<float>() * back);
+  DepthImage d2(100, 80, back_cam.z());
+  facing.observe(d2, K, T_wc);
+  EXPECT_EQ(facing.observed(), 2u);
+}
+
 TEST(ObservedSurface, BadInputIsNamed) {
   const std::vector<Eigen::Vector3f> pts = {Eigen::Vector3f(0, 0, 1)};
   EXPECT_THROW(ObservedSurface(pts, 0.0), std::invalid_argument);
   EXPECT_THROW(ObservedSurface(pts, -1.0), std::invalid_argument);
+  const std::vector<Eigen::Vector3f> two_normals = {Eigen::Vector3f::UnitZ(), Eigen::Vector3f::UnitZ()};
+  EXPECT_THROW(ObservedSurface(pts, 0.05, two_normals), std::invalid_argument);
   ObservedSurface seen(pts, 0.05);
   try {
     seen.observe(DepthImage(10, 10, 1.0f), camera(), Eigen::Isometry3d::Identity());
