@@ -1,6 +1,8 @@
 // rrg fuse: TSDF fusion (core/tsdf) of a posed RGB-D dataset with its ground-truth poses, then a
-// marching-cubes mesh as PLY and optionally the volume file.
+// marching-cubes mesh as PLY and optionally the volume file. Ctrl-C stops after the frame in
+// progress and still writes the mesh (and volume) of the frames fused, then exits 128 + signal.
 #include "client/commands/command.h"
+#include "client/commands/stop_on_signal.h"
 #include "core/common/device.h"
 #include "core/io/dataset.h"
 #include "core/io/ply.h"
@@ -46,8 +48,15 @@ void run_fuse(const FuseOptions& o) {
 
   double t_load = 0, t_fuse = 0, t_raycast = 0;
   size_t fused = 0, skipped = 0;
+  const StopOnSignal signals;
+  bool interrupted = false;
   for (size_t i = 0; i < dataset->size(); i += size_t(o.every)) {
     if (o.max_frames > 0 && fused >= size_t(o.max_frames)) break;
+    if (signals.signal() != 0) {
+      spdlog::warn("fuse: stopped before frame {} of {}; writing the mesh of the {} frames fused", i, dataset->size(), fused);
+      interrupted = true;
+      break;
+    }
     auto t0 = Clock::now();
     const io::Frame frame = dataset->load(i);
     const auto depth = DeviceImage<float>::from_host(frame.depth, device);
@@ -92,6 +101,7 @@ void run_fuse(const FuseOptions& o) {
   std::printf("timing: load %.2f ms/frame, fusion %.2f ms/frame", t_load / double(fused), t_fuse / double(fused));
   if (o.raycast) std::printf(", raycast %.2f ms/frame", t_raycast / double(fused));
   std::printf(", extraction %.1f ms, ply write %.1f ms\n", t_extract, t_write);
+  if (interrupted) signals.finish_interrupted(fused);
 }
 
 }  // namespace

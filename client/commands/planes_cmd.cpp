@@ -6,6 +6,7 @@
 //                       global plane table, semantic cue, 5-window vote) on a synthetic sequence,
 //                       scored against planes.json.
 #include "client/commands/command.h"
+#include "client/commands/stop_on_signal.h"
 #include "core/common/device.h"
 #include "core/io/dataset.h"
 #include "core/io/image_io.h"
@@ -132,6 +133,8 @@ void run_eval(const EvalOptions& o) {
   e.params.variance_skip_color_edges = !o.no_color_edges;
   spdlog::info("planes eval: {} semantics {} period {} voxel {} m on {}, δ_v {} δ_area {}", o.dataset, o.semantics,
                o.period, o.voxel, e.device.to_string(), o.delta_v, o.delta_area);
+  const StopOnSignal signals;  // Ctrl-C: stop after the current frame and score the frames done
+  e.stop = [&signals] { return signals.signal() != 0; };
   const PlaneEvalReport r = run_plane_eval(e);
   nlohmann::json j = {{"frames", r.frames}, {"windows", r.windows}, {"global_planes", r.global_planes},
                       {"segmentation", {{"precision", r.segmentation.precision()}, {"recall", r.segmentation.recall()},
@@ -151,8 +154,10 @@ void run_eval(const EvalOptions& o) {
                          {"ms", {{"segment", c.mean_ms.segment_ms}, {"associate", c.mean_ms.associate_ms},
                                  {"semantic", c.mean_ms.semantic_ms}, {"verify", c.mean_ms.verify_ms},
                                  {"identify", c.mean_ms.total_ms}}}});
+  if (r.interrupted) j["interrupted"] = true;
   if (o.json) {
     std::cout << j.dump(1) << "\n";
+    if (r.interrupted) throw ExitWith{signals.exit_code()};
     return;
   }
   std::printf("frames %zu, identification windows %zu, live global planes %d\n", r.frames, r.windows, r.global_planes);
@@ -180,6 +185,7 @@ void run_eval(const EvalOptions& o) {
                 c.mean_ms.associate_ms, c.mean_ms.semantic_ms, c.mean_ms.verify_ms, c.mean_ms.total_ms);
   }
   std::printf("TSDF: fuse %.2f ms per frame, raycast %.2f ms per step\n", r.fuse_ms, r.raycast_ms);
+  if (r.interrupted) signals.finish_interrupted(r.frames);
 }
 
 }  // namespace

@@ -135,8 +135,7 @@ void run(const RunCliOptions& o) {
   }
   if (!o.out.empty()) std::printf("outputs -> %s (trajectory.txt, mesh.ply/.drc, gaussians_*.ply/.spz, renders/, metrics.json, timings.json)\n", o.out.c_str());
   if (runs.back().second.metrics.interrupted) {
-    std::printf("interrupted after %zu frames; the outputs above cover those frames\n", runs.back().second.metrics.frames);
-    throw ExitWith{signals.exit_code()};
+    signals.finish_interrupted(runs.back().second.metrics.frames);
   }
 }
 

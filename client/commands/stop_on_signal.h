@@ -1,11 +1,15 @@
 #pragma once
-// Ctrl-C for long commands (`rrg run`, `rrg track`): while a StopOnSignal is alive, the first SIGINT
+// Ctrl-C for long commands (`rrg run`, `rrg track`, `rrg fuse`, `rrg planes eval`): while a StopOnSignal is alive, the first SIGINT
 // or SIGTERM only records itself, so the command can stop after the frame in progress and still
 // write its outputs; it then ends with ExitWith{128 + signal}. A second signal aborts at once.
+#include "client/commands/command.h"
+
 #include <unistd.h>
 
 #include <atomic>
 #include <csignal>
+#include <cstddef>
+#include <cstdio>
 
 namespace rrg::cli {
 
@@ -34,6 +38,11 @@ class StopOnSignal {
   StopOnSignal& operator=(const StopOnSignal&) = delete;
   int signal() const { return g_stop_signal.load(); }  // 0 while none arrived
   int exit_code() const { return 128 + (signal() != 0 ? signal() : SIGINT); }  // the shell's code for a job it ended
+  // The end of a command that stopped early and wrote what it had: says so, then exits 128 + signal.
+  [[noreturn]] void finish_interrupted(size_t frames) const {
+    std::printf("interrupted after %zu frames; the outputs above cover those frames\n", frames);
+    throw ExitWith{exit_code()};
+  }
 
  private:
   void (*old_int_)(int);

@@ -164,8 +164,7 @@ void run_track(const TrackOptions& o) {
     std::printf("mesh: %zu vertices, %zu triangles -> %s\n", mesh.vertices.size(), mesh.triangles.size(), o.mesh.c_str());
   }
   if (interrupted) {
-    std::printf("interrupted after %zu frames; the outputs above cover those frames\n", n);
-    throw ExitWith{signals.exit_code()};
+    signals.finish_interrupted(n);
   }
 }
 

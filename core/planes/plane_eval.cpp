@@ -67,7 +67,7 @@ PlaneEvalReport run_plane_eval(const PlaneEvalOptions& options) {
   const auto dataset = io::open_dataset(options.dataset);
   const Intrinsics K = dataset->intrinsics();
   const auto gt_planes = read_gt_planes(io::synth_scene_file(options.dataset, "planes.json"));
-  const size_t frames = options.max_frames > 0 ? std::min(options.max_frames, dataset->size()) : dataset->size();
+  size_t frames = options.max_frames > 0 ? std::min(options.max_frames, dataset->size()) : dataset->size();
 
   std::vector<PlaneIdentifier> identifiers;
   std::vector<IdentificationScorer> scorers;
@@ -144,6 +144,11 @@ PlaneEvalReport run_plane_eval(const PlaneEvalOptions& options) {
       spdlog::info("planes eval: frame {}/{}, {} global planes, L_ref {} ({})", k + 1, frames,
                    identifiers[0].table().live_ids().size(), identifiers[0].vote().lookup_table().size(),
                    options.semantics[0]);
+    if (k + 1 < frames && options.stop && options.stop()) {
+      spdlog::warn("planes eval: stopped after frame {} of {}; scoring those frames", k + 1, frames);
+      frames = k + 1;
+      report.interrupted = true;
+    }
   }
   report.frames = frames;
   report.fuse_ms = frames > 0 ? fuse_ms / double(frames) : 0;

@@ -12,6 +12,7 @@
 
 #include <filesystem>
 #include <string>
+#include <functional>
 #include <vector>
 
 namespace rrg {
@@ -28,6 +29,7 @@ struct PlaneEvalOptions {
   Device device = Device::cpu();                    // TSDF device
   IdentificationParams params;
   double min_fraction = 0.02;                       // planes covering > 2% of the image
+  std::function<bool()> stop;                       // polled after each frame: true ends the run early (scored over the frames done)
 };
 
 struct PlaneEvalCueReport {
@@ -39,6 +41,7 @@ struct PlaneEvalCueReport {
 
 struct PlaneEvalReport {
   size_t frames = 0, windows = 0;
+  bool interrupted = false;         // options.stop ended it before the last frame
   SegmentationCounts segmentation;  // over identification frames (first cue's segmentation)
   IdStability ids;
   std::vector<PlaneEvalCueReport> cues;

@@ -1,4 +1,5 @@
 // `rrg planes` through the real executable on a tiny synthetic sequence.
+#include "core/planes/plane_eval.h"
 #include "tests/support/test_support.h"
 
 #include <gtest/gtest.h>
@@ -42,6 +43,26 @@ TEST_F(PlanesCli, SegmentPrintsScoresAndWritesMaps) {
   EXPECT_GT(j["precision"].get<double>(), 0.5);
   EXPECT_GT(j["recall"].get<double>(), 0.5);
   EXPECT_TRUE(std::filesystem::exists(out / "000002.png"));
+}
+
+// The stop hook (Ctrl-C in `rrg planes eval`): polled after each frame; the report covers the
+// frames done and says it was interrupted.
+TEST_F(PlanesCli, EvalStopsWhenAskedAndScoresTheFramesDone) {
+  PlaneEvalOptions e;
+  e.dataset = seq();
+  e.period = 1;
+  e.voxel_size = 0.04f;
+  int polls = 0;
+  e.stop = [&polls] { return ++polls >= 2; };  // after the second frame
+  const PlaneEvalReport r = run_plane_eval(e);
+  EXPECT_TRUE(r.interrupted);
+  EXPECT_EQ(r.frames, 2u);
+  EXPECT_EQ(r.windows, 2u);
+  EXPECT_EQ(polls, 2);
+  e.stop = [] { return false; };
+  const PlaneEvalReport all = run_plane_eval(e);
+  EXPECT_FALSE(all.interrupted);
+  EXPECT_EQ(all.frames, 3u);
 }
 
 TEST_F(PlanesCli, EvalRunsBothCuesWithFusion) {
