@@ -24,11 +24,8 @@ KdTree::KdTree(std::vector<Eigen::Vector3f> points) : points_(std::move(points))
   original_.resize(points_.size());
   std::iota(original_.begin(), original_.end(), 0u);
   axis_.assign(points_.size(), 0);
-  lower_ = upper_ = points_.front();
-  for (const auto& p : points_) {
-    lower_ = lower_.cwiseMin(p);
-    upper_ = upper_.cwiseMax(p);
-  }
+  lower_.assign(points_.size(), Eigen::Vector3f::Zero());
+  upper_.assign(points_.size(), Eigen::Vector3f::Zero());
   build(0, points_.size());
 }
 
@@ -44,6 +41,8 @@ void KdTree::build(size_t lo, size_t hi) {
 
   // Partition an index range, then apply it to points_ and original_ together.
   const size_t mid = lo + (hi - lo) / 2;
+  lower_[mid] = lower;
+  upper_[mid] = upper;
   std::vector<uint32_t> order(hi - lo);
   std::iota(order.begin(), order.end(), uint32_t(lo));
   std::nth_element(order.begin(), order.begin() + (mid - lo), order.end(),
@@ -63,14 +62,18 @@ void KdTree::build(size_t lo, size_t hi) {
 
 KdTree::Neighbor KdTree::nearest(const Eigen::Vector3f& q) const {
   Neighbor best{0, std::numeric_limits<float>::infinity()};
-  const Eigen::Vector3f off = (lower_ - q).cwiseMax(0.0f) + (q - upper_).cwiseMax(0.0f);
-  search(0, points_.size(), q, off, off.squaredNorm(), best);
+  search(0, points_.size(), q, box_distance_sq(0, points_.size(), q), best);
   best.index = original_[best.index];
   return best;
 }
 
-void KdTree::search(size_t lo, size_t hi, const Eigen::Vector3f& q, const Eigen::Vector3f& off, float box_sq,
-                    Neighbor& best) const {
+float KdTree::box_distance_sq(size_t lo, size_t hi, const Eigen::Vector3f& q) const {
+  if (hi - lo <= kLeafSize) return 0.0f;  // leaves keep no box: their few points are checked directly
+  const size_t mid = lo + (hi - lo) / 2;
+  return ((lower_[mid] - q).cwiseMax(0.0f) + (q - upper_[mid]).cwiseMax(0.0f)).squaredNorm();
+}
+
+void KdTree::search(size_t lo, size_t hi, const Eigen::Vector3f& q, float box_sq, Neighbor& best) const {
   if (box_sq > best.distance_sq * (1.0f + kPruneSlack)) return;
   if (hi - lo <= kLeafSize) {
     for (size_t i = lo; i < hi; ++i) {
@@ -82,19 +85,15 @@ void KdTree::search(size_t lo, size_t hi, const Eigen::Vector3f& q, const Eigen:
   const size_t mid = lo + (hi - lo) / 2;
   const float d2 = (points_[mid] - q).squaredNorm();
   if (d2 < best.distance_sq) best = {mid, d2};
-  // [lo, mid) lies at or below the splitting plane, [mid + 1, hi) at or above it. The near side
-  // keeps q's box offset; on the far side the offset along the split axis becomes |diff|.
-  const int axis = axis_[mid];
-  const float diff = q[axis] - points_[mid][axis];
-  Eigen::Vector3f far_off = off;
-  far_off[axis] = std::max(off[axis], std::abs(diff));
-  const float far_sq = far_off.squaredNorm();
-  if (diff < 0.0f) {
-    search(lo, mid, q, off, box_sq, best);
-    search(mid + 1, hi, q, far_off, far_sq, best);
+  // [lo, mid) lies at or below the splitting point along the axis, [mid + 1, hi) at or above it:
+  // the side q is on first, each child pruned by its own box.
+  const float below = box_distance_sq(lo, mid, q), above = box_distance_sq(mid + 1, hi, q);
+  if (q[axis_[mid]] < points_[mid][axis_[mid]]) {
+    search(lo, mid, q, below, best);
+    search(mid + 1, hi, q, above, best);
   } else {
-    search(mid + 1, hi, q, off, box_sq, best);
-    search(lo, mid, q, far_off, far_sq, best);
+    search(mid + 1, hi, q, above, best);
+    search(lo, mid, q, below, best);
   }
 }
 

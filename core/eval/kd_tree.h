@@ -2,9 +2,11 @@
 // A static 3-D kd-tree for exact nearest-neighbour queries (mesh accuracy / completion). Implicit
 // layout: the points are reordered so that every range [lo, hi) has its splitting point at its
 // middle, split on the axis of the range's largest extent; ranges of ≤ 8 points are leaves.
-// The search keeps the query's per-axis offset to the current cell's box (Arya & Mount's
-// incremental distance), so a cell is skipped when its whole box is farther than the best point:
-// essential for queries off the sampled surface (every cell is then at least that far).
+// Every inner range keeps the tight bounding box of its points, and the search skips a range
+// whose box is farther than the best point so far. Tight boxes matter for queries far off the
+// sampled surface (completion of unreconstructed regions, metres away): the half-spaces of the
+// splitting planes bound a surface's points far more loosely than their own thin boxes, and with
+// those bounds a query 1 m away visited most of a room's samples.
 // Queries are const and thread-safe.
 #include <Eigen/Core>
 
@@ -29,14 +31,14 @@ class KdTree {
 
  private:
   void build(size_t lo, size_t hi);
-  // off: per-axis distance from q to the box of [lo, hi); box_sq = ‖off‖².
-  void search(size_t lo, size_t hi, const Eigen::Vector3f& q, const Eigen::Vector3f& off, float box_sq,
-              Neighbor& best) const;
+  // box_sq: squared distance from q to the box of [lo, hi) (0 when [lo, hi) is a leaf).
+  void search(size_t lo, size_t hi, const Eigen::Vector3f& q, float box_sq, Neighbor& best) const;
+  float box_distance_sq(size_t lo, size_t hi, const Eigen::Vector3f& q) const;
 
   std::vector<Eigen::Vector3f> points_;  // reordered
   std::vector<uint32_t> original_;       // points_[i] was input point original_[i]
   std::vector<uint8_t> axis_;            // split axis of the range whose middle is i
-  Eigen::Vector3f lower_, upper_;        // bounding box of all points
+  std::vector<Eigen::Vector3f> lower_, upper_;  // tight box of the inner range whose middle is i
 };
 
 }  // namespace rrg::eval
