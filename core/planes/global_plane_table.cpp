@@ -139,6 +139,18 @@ FrameAssociation GlobalPlaneTable::associate(std::span<const LocalObservation> o
   for (const LocalObservation& obs : observations) {
     if (obs.points.size() < 3) continue;
     const std::vector<CandidateScore> scores = score(obs, frame);
+    // Candidates the observation lies on within its noise come before those only within the
+    // filter's 0.1 m (a wall's piece beside a mirror frame's bar 5 cm in front of it); then the
+    // highest overlap, IoU, smallest gap.
+    const auto on_plane = [&](const CandidateScore& c) {
+      return std::abs(planes_[size_t(c.global_id - 1)].plane.signed_distance(obs.centroid)) < obs.same_plane_distance;
+    };
+    const auto better = [&](const CandidateScore& s, const CandidateScore& b) {
+      if (on_plane(s) != on_plane(b)) return on_plane(s);
+      if (s.overlap != b.overlap) return s.overlap > b.overlap;
+      if (s.iou != b.iou) return s.iou > b.iou;
+      return s.gap < b.gap;
+    };
     const CandidateScore* best = nullptr;
     std::vector<int> blocked;  // matching instances held by a different surface of this frame
     for (const CandidateScore& s : scores) {
@@ -147,14 +159,7 @@ FrameAssociation GlobalPlaneTable::associate(std::span<const LocalObservation> o
         blocked.push_back(s.global_id);
         continue;
       }
-      // Candidates the observation lies on within its noise come before those only within the
-      // filter's 0.1 m (a wall's piece beside a mirror frame's bar 5 cm in front of it).
-      const bool near = std::abs(planes_[size_t(s.global_id - 1)].plane.signed_distance(obs.centroid)) < obs.same_plane_distance;
-      const bool best_near = best && std::abs(planes_[size_t(best->global_id - 1)].plane.signed_distance(obs.centroid)) < obs.same_plane_distance;
-      if (!best || (near && !best_near) ||
-          (near == best_near && (s.overlap > best->overlap || (s.overlap == best->overlap && s.iou > best->iou) ||
-                                 (s.overlap == best->overlap && s.iou == best->iou && s.gap < best->gap))))
-        best = &s;
+      if (!best || better(s, *best)) best = &s;
     }
     int id = best ? best->global_id : 0;
     // Kept off an instance by a different surface and matching no other: a piece of a surface of
