@@ -59,6 +59,10 @@ std::vector<LocalObservation> GlobalPlaneTable::observe(const PlaneSegmentation&
   return out;
 }
 
+float GlobalPlaneTable::cos_max_normal_angle() const {
+  return std::cos(params_.max_normal_angle_deg * std::numbers::pi_v<float> / 180.0f);
+}
+
 bool GlobalPlaneTable::geometric_match(const Plane& a, const Eigen::Vector3f& centroid_b) const {
   // Only plane a's normal is compared here; callers pass both orders where symmetry matters.
   return std::abs(a.signed_distance(centroid_b)) <= params_.max_distance;
@@ -69,7 +73,7 @@ bool GlobalPlaneTable::geometric_match(const Plane& a, const Eigen::Vector3f& ce
 // plane with fewer points within its same_plane_distance of the plane with more (a small piece's fit
 // may tilt by degrees, which over a metre between the pieces would exceed any noise bound).
 bool GlobalPlaneTable::same_surface(const LocalObservation& a, const LocalObservation& b) const {
-  const float cos_max = std::cos(params_.max_normal_angle_deg * std::numbers::pi_v<float> / 180.0f);
+  const float cos_max = cos_max_normal_angle();
   const bool a_larger = a.points.size() >= b.points.size();
   const LocalObservation& large = a_larger ? a : b;
   const LocalObservation& small = a_larger ? b : a;
@@ -78,7 +82,7 @@ bool GlobalPlaneTable::same_surface(const LocalObservation& a, const LocalObserv
 }
 
 std::vector<CandidateScore> GlobalPlaneTable::score(const LocalObservation& obs, int64_t frame) const {
-  const float cos_max = std::cos(params_.max_normal_angle_deg * std::numbers::pi_v<float> / 180.0f);
+  const float cos_max = cos_max_normal_angle();
   std::vector<CandidateScore> out;
   for (const GlobalPlane& g : planes_) {
     if (!g.alive || g.plane.n.dot(obs.plane.n) < cos_max || !geometric_match(g.plane, obs.centroid)) continue;
@@ -197,7 +201,7 @@ FrameAssociation GlobalPlaneTable::associate(std::span<const LocalObservation> o
 }
 
 void GlobalPlaneTable::merge_pass(std::span<const int> touched, FrameAssociation& out) {
-  const float cos_max = std::cos(params_.max_normal_angle_deg * std::numbers::pi_v<float> / 180.0f);
+  const float cos_max = cos_max_normal_angle();
   for (int t : touched) {
     for (bool changed = true; changed;) {
       changed = false;

@@ -113,6 +113,7 @@ class GlobalPlaneTable {
 
  private:
   friend struct PlaneStateIo;  // snapshots (plane_state_io.h)
+  float cos_max_normal_angle() const;  // cos of the geometric filter's normal angle
   bool geometric_match(const Plane& a, const Eigen::Vector3f& centroid_b) const;
   bool same_surface(const LocalObservation& a, const LocalObservation& b) const;
   void absorb(GlobalPlane& into, const LocalObservation& obs, int64_t frame);

@@ -27,7 +27,6 @@
 namespace rrg {
 namespace {
 
-
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
