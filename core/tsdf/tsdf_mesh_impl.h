@@ -22,6 +22,7 @@ struct MeshArgs {
   bool emit;
   Span<int32_t> counts;                // [2m] vertices, triangles (count pass)
   Span<const int64_t> offsets;         // [2m] first vertex, first triangle (emit pass)
+  int64_t vertex_base = 0;             // added to the vertex indices written into `triangles`
   Span<Eigen::Vector3f> positions, colors;
   Span<int32_t> planes;
   Span<Eigen::Vector4i> edge_keys;     // global lower voxel and axis of each vertex (welding)
@@ -93,7 +94,10 @@ void mesh_blocks(Backend backend, const MeshArgs& a) {
               idx[q] = slots[slot];
             }
             if (args.emit)
-              args.triangles[t0 + nt] = Eigen::Vector3i(int(v0 + idx[0]), int(v0 + idx[1]), int(v0 + idx[2]));
+              {
+              const int64_t b = args.vertex_base + v0;
+              args.triangles[t0 + nt] = Eigen::Vector3i(int(b + idx[0]), int(b + idx[1]), int(b + idx[2]));
+            }
             ++nt;
           }
         }

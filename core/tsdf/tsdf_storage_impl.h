@@ -124,8 +124,6 @@ struct AppendArgs {
   uint64_t version;
   Span<int32_t> active;        // new blocks are listed at active[active_offset + j] (if >= 0)
   int32_t active_offset;
-  Span<TsdfVoxel> geometry;    // new blocks are zeroed in both layers
-  Span<AttrVoxel> attributes;
 };
 
 template <class Backend>
@@ -139,11 +137,7 @@ void append_blocks(Backend backend, const AppendArgs& a) {
     args.stamps[block] = args.pass_id;
     if (args.active_offset >= 0) args.active[args.active_offset + j] = block;
   });
-  const int64_t first_voxel = int64_t(a.first_block) * kBlockVoxels;
-  parallel_for(backend, a.keys.size * kBlockVoxels, [=] RRG_HD(int64_t i) {
-    args.geometry[first_voxel + i] = TsdfVoxel{};
-    args.attributes[first_voxel + i] = AttrVoxel{};
-  });
+  // The new blocks' voxels are already zero: TsdfVolume keeps free pool slots zeroed.
 }
 
 template <class Backend>

@@ -33,6 +33,12 @@ void resize_keep(Buffer<T>& b, int64_t capacity, int64_t keep, const Device& dev
   b = std::move(bigger);
 }
 
+// Zeroes elements [from, to) of b: free pool slots hold zero voxels (TsdfVolume's pool invariant).
+template <class T>
+void zero_range(Buffer<T>& b, int64_t from, int64_t to, const Device& device) {
+  if (to > from) mem::fill_zero(b.data() + from, size_t(to - from) * sizeof(T), device);
+}
+
 // Initial hash slots: 4 per initial pool block, and at least 65536 (768 KB), enough for the ~20k
 // blocks a 640x480 frame at 5 mm touches without a grow-and-retry pass. Not more: every ray step
 // through empty space probes the table for an absent block, so a table far beyond the load needed
@@ -50,8 +56,11 @@ TsdfVolume::TsdfVolume(const TsdfParams& params, const Device& device) : params_
   params_.validate();
   require_device(device_);
   const int64_t blocks = params_.initial_blocks;
-  geometry_ = Buffer<TsdfVoxel>(size_t(blocks) * kBlockVoxels, device_);
-  attributes_ = Buffer<AttrVoxel>(size_t(blocks) * kBlockVoxels, device_);
+  // Free pool slots are zero voxels (weight 0, no colour, no statistics), so a new block needs no
+  // initialisation: the pool is zeroed here (its pages committed once, as Open3D's VoxelBlockGrid
+  // does for its capacity), on growth and where compaction frees slots.
+  geometry_ = Buffer<TsdfVoxel>::zeros(size_t(blocks) * kBlockVoxels, device_);
+  attributes_ = Buffer<AttrVoxel>::zeros(size_t(blocks) * kBlockVoxels, device_);
   block_keys_ = Buffer<uint64_t>(size_t(blocks), device_);
   block_versions_ = Buffer<uint64_t>(size_t(blocks), device_);
   block_stamps_ = Buffer<int32_t>::zeros(size_t(blocks), device_);
@@ -129,6 +138,8 @@ void TsdfVolume::ensure_pool(int64_t blocks) {
   spdlog::debug("tsdf: block pool {} -> {} blocks", capacity, bigger);
   resize_keep(geometry_, bigger * kBlockVoxels, num_blocks_ * kBlockVoxels, device_);
   resize_keep(attributes_, bigger * kBlockVoxels, num_blocks_ * kBlockVoxels, device_);
+  zero_range(geometry_, num_blocks_ * kBlockVoxels, bigger * kBlockVoxels, device_);
+  zero_range(attributes_, num_blocks_ * kBlockVoxels, bigger * kBlockVoxels, device_);
   resize_keep(block_keys_, bigger, num_blocks_, device_);
   resize_keep(block_versions_, bigger, num_blocks_, device_);
   resize_keep(block_stamps_, bigger, num_blocks_, device_);
@@ -215,10 +226,10 @@ void TsdfVolume::append_blocks(std::span<const uint64_t> keys, std::span<const i
   const int64_t capacity = int64_t(block_keys_.size());
   kernel::AppendArgs a{hash_view(), keys_d.span(), slots_d.span(), int32_t(first),
                        block_keys_.span(), block_versions_.span(), block_stamps_.span(), pass_id_, version_,
-                       {active_.data(), capacity}, int32_t(active_offset), geometry_.span(), attributes_.span()};
+                       {active_.data(), capacity}, int32_t(active_offset)};
   RRG_DISPATCH(device_, kernel::append_blocks_cpu(a), kernel::append_blocks_cuda(a));
   num_blocks_ += n;
-  // Blocks coming back from host memory: their voxels replace the zeros.
+  // Blocks coming back from host memory: their voxels replace the zeros of the free slots.
   std::vector<int32_t> index;
   std::vector<Voxel> staged;
   for (int64_t j = 0; j < n; ++j) {
@@ -288,6 +299,8 @@ int64_t TsdfVolume::stream_out(const Eigen::Vector3f& center, float radius) {
     kept_keys.push_back(keys[size_t(i)]);
     kept_versions.push_back(versions[size_t(i)]);
   }
+  zero_range(geometry_, int64_t(keep.size()) * kBlockVoxels, num_blocks_ * kBlockVoxels, device_);
+  zero_range(attributes_, int64_t(keep.size()) * kBlockVoxels, num_blocks_ * kBlockVoxels, device_);
   num_blocks_ = int64_t(keep.size());
   if (num_blocks_ > 0) {
     mem::copy(block_keys_.data(), device_, kept_keys.data(), Device::cpu(), kept_keys.size() * sizeof(uint64_t));

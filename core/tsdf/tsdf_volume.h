@@ -105,8 +105,8 @@ class TsdfVolume {
   Device device_;
   Buffer<uint64_t> hash_keys_;       // [capacity] packed block coordinates, kEmptyKey = free
   Buffer<int32_t> hash_values_;      // [capacity] block index, -1 = free
-  Buffer<TsdfVoxel> geometry_;       // [pool capacity * 512] geometry layer
-  Buffer<AttrVoxel> attributes_;     // [pool capacity * 512] attribute layer
+  Buffer<TsdfVoxel> geometry_;       // [pool capacity * 512] geometry layer; free slots (blocks >= num_blocks_) zero
+  Buffer<AttrVoxel> attributes_;     // [pool capacity * 512] attribute layer; free slots zero
   Buffer<uint64_t> block_keys_;      // [pool capacity]
   Buffer<uint64_t> block_versions_;  // [pool capacity] version of the last fusion into the block
   Buffer<int32_t> block_stamps_;     // [pool capacity] allocation pass that last listed it active

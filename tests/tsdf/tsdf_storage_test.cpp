@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <set>
 #include <tuple>
 
@@ -128,6 +129,37 @@ TEST(TsdfStorage, IntegrationBringsStreamedOutBlocksBack) {
     EXPECT_GT(streamed.num_blocks(), 0);
     EXPECT_GT(streamed.num_host_blocks(), 0);  // blocks the last frame did not touch stay out
     EXPECT_EQ(test::flatten_voxels(streamed), test::flatten_voxels(plain));
+  }
+}
+
+// Streaming out frees pool slots that still held voxels; a block allocated later into such a slot
+// must start empty (the volume keeps free slots zero, and allocation writes no voxel).
+TEST(TsdfStorage, ABlockAllocatedIntoAFreedSlotStartsEmpty) {
+  const test::Scene scene = test::sphere_scene({0, 0, 0}, 0.25f);
+  const DepthImage wall(kK.width, kK.height, 1.0f);
+  Eigen::Isometry3f far = Eigen::Isometry3f::Identity();
+  far.translation() = Eigen::Vector3f(0, 0, 10);  // the wall at z = 11 m, far from the sphere's blocks
+  for (const Device& device : available_devices()) {
+    SCOPED_TRACE(device.to_string());
+    const ColorImage grey(kK.width, kK.height, Color(0.5f, 0.5f, 0.5f));
+    const auto c = DeviceImage<Color>::from_host(grey, device);
+    const auto d = DeviceImage<float>::from_host(wall, device);
+    TsdfVolume reused(params(), device), fresh(params(), device);
+    test::fuse_scene(reused, scene, kK, test::cameras_around({0, 0, 0}, 0.9f));
+    const int64_t sphere_blocks = reused.num_blocks();
+    EXPECT_EQ(reused.stream_out({0, 0, 0}, -1.0f), sphere_blocks);  // every slot freed
+    integrate(reused, d, c, kK, far);
+    integrate(fresh, d, c, kK, far);
+    ASSERT_EQ(reused.num_blocks(), fresh.num_blocks());
+    ASSERT_GT(fresh.num_blocks(), 0);
+    // The wall's first sphere_blocks blocks went into freed slots (the pool is filled from slot 0).
+    for (const auto& b : fresh.block_coords()) {
+      const auto got = reused.read_block(b), want = fresh.read_block(b);
+      ASSERT_TRUE(got && want);
+      ASSERT_EQ(got->voxels.size(), want->voxels.size());
+      for (size_t i = 0; i < want->voxels.size(); ++i)
+        ASSERT_EQ(std::memcmp(&got->voxels[i], &want->voxels[i], sizeof(Voxel)), 0) << "voxel " << i;
+    }
   }
 }
 
