@@ -136,17 +136,20 @@ int main(int argc, char** argv) {
   const o3c::Tensor all_blocks = hashmap.GetKeyTensor().IndexGet({hashmap.GetActiveIndices().To(o3c::Int64)});
 
   Times ray_all;  // ours with the reflection maps too (I, R_raw, R, C_var), against the same Open3D run
+  // Ours raycasts into the same images every frame, as the tracking loop does (raycast_into);
+  // Open3D's RayCast returns new tensors on every call (its API takes no output).
+  rrg::RaycastResult r, r_all;
   double depth_diff = 0;
   int64_t both_hit = 0, hit_ours = 0, hit_open3d = 0;
   for (int i = 0; i < frames; ++i) {
     Clock t0 = now();
-    const rrg::RaycastResult r = rrg::raycast(ours, K, poses[size_t(i)], {}, {.color = true, .reflection = false});
+    rrg::raycast_into(r, ours, K, poses[size_t(i)], {}, {.color = true, .reflection = false});
     Clock t1 = now();
     auto o = vbg.RayCast(all_blocks, intr, extrinsic_tensor(poses[size_t(i)]), width, height,
                          {"depth", "vertex", "normal", "color"}, 1.0f, params.min_depth, max_depth, 1.0f, trunc_mult, 8);
     Clock t2 = now();
     ray.add(t0, t1, t2);
-    rrg::raycast(ours, K, poses[size_t(i)]);
+    rrg::raycast_into(r_all, ours, K, poses[size_t(i)]);
     Clock t3 = now();
     ray_all.add(t2, t3, t1, t2);
     const rrg::DepthImage d = r.depth.to_host();

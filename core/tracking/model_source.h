@@ -6,8 +6,6 @@
 #include "core/tsdf/tsdf_raycast.h"
 #include "core/tsdf/tsdf_volume.h"
 
-#include <optional>
-
 namespace rrg {
 
 class ModelSource {
@@ -18,18 +16,20 @@ class ModelSource {
 };
 
 // Raycasts a TSDF volume (V*, N* in the world frame; the geometry only, RaycastOutputs) with
-// intrinsics K; the last raycast is kept and reused when asked again for the same pose.
+// intrinsics K; the last raycast is kept and reused when asked again for the same pose, and its
+// images are raycast into again for the next pose (no allocation per frame).
 class TsdfModelSource final : public ModelSource {
  public:
   TsdfModelSource(const TsdfVolume& volume, const Intrinsics& K) : volume_(volume), K_(K) {}
   IcpModel model_at(const Eigen::Isometry3f& T_wc) override;
   // Forgets the cached raycast (call after fusing a frame).
-  void invalidate() { cached_.reset(); }
+  void invalidate() { valid_ = false; }
 
  private:
   const TsdfVolume& volume_;
   Intrinsics K_;
-  std::optional<RaycastResult> cached_;
+  RaycastResult cached_;
+  bool valid_ = false;
   Eigen::Isometry3f cached_T_ = Eigen::Isometry3f::Identity();
 };
 

@@ -7,17 +7,31 @@
 
 namespace rrg {
 
-RaycastResult raycast(const TsdfVolume& volume, const Intrinsics& K, const Eigen::Isometry3f& T_wc,
-                      std::span<const int32_t> plane_remap, RaycastOutputs outputs) {
+namespace {
+
+// Gives img the size w x h on dev, keeping its buffer when it has it already.
+template <class T>
+void fit(DeviceImage<T>& img, int w, int h, const Device& dev) {
+  if (img.width() != w || img.height() != h || !(img.device() == dev)) img = DeviceImage<T>(w, h, dev);
+}
+
+}  // namespace
+
+void raycast_into(RaycastResult& r, const TsdfVolume& volume, const Intrinsics& K, const Eigen::Isometry3f& T_wc,
+                  std::span<const int32_t> plane_remap, RaycastOutputs outputs) {
   if (!K.valid()) throw std::invalid_argument("raycast: invalid intrinsics " + K.to_string());
   const Device& dev = volume.device();
   const int w = K.width, h = K.height;
   const int wc = outputs.color ? w : 0, hc = outputs.color ? h : 0;
   const int wr = outputs.reflection ? w : 0, hr = outputs.reflection ? h : 0;
-  RaycastResult r{DeviceImage<float>(w, h, dev),             DeviceImage<Eigen::Vector3f>(w, h, dev),
-                  DeviceImage<Eigen::Vector3f>(w, h, dev),   DeviceImage<Eigen::Vector3f>(wc, hc, dev),
-                  DeviceImage<int32_t>(wr, hr, dev),         DeviceImage<float>(wr, hr, dev),
-                  DeviceImage<uint8_t>(wr, hr, dev),         DeviceImage<float>(wr, hr, dev)};
+  fit(r.depth, w, h, dev);
+  fit(r.vertices, w, h, dev);
+  fit(r.normals, w, h, dev);
+  fit(r.colors, wc, hc, dev);
+  fit(r.plane_ids, wr, hr, dev);
+  fit(r.reflection, wr, hr, dev);
+  fit(r.reflection_mask, wr, hr, dev);
+  fit(r.color_variance, wr, hr, dev);
   const auto remap = Buffer<int32_t>::from_host(plane_remap, dev);
   const TsdfParams& p = volume.params();
   const int tiles_x = (w + kernel::kRangeTile - 1) / kernel::kRangeTile;
@@ -30,6 +44,12 @@ RaycastResult raycast(const TsdfVolume& volume, const Intrinsics& K, const Eigen
                         r.plane_ids.view(), r.reflection.view(), r.reflection_mask.view(),
                         r.color_variance.view(), outputs.color, outputs.reflection};
   RRG_DISPATCH(dev, kernel::raycast_cpu(a), kernel::raycast_cuda(a));
+}
+
+RaycastResult raycast(const TsdfVolume& volume, const Intrinsics& K, const Eigen::Isometry3f& T_wc,
+                      std::span<const int32_t> plane_remap, RaycastOutputs outputs) {
+  RaycastResult r;
+  raycast_into(r, volume, K, T_wc, plane_remap, outputs);
   return r;
 }
 

@@ -40,4 +40,9 @@ struct RaycastResult {
 RaycastResult raycast(const TsdfVolume& volume, const Intrinsics& K, const Eigen::Isometry3f& T_wc,
                       std::span<const int32_t> plane_remap = {}, RaycastOutputs outputs = RaycastOutputs::all());
 
+// The same into `out`, reusing its images where they already have the size needed (a loop that
+// raycasts every frame, as tracking does, then allocates nothing after the first call).
+void raycast_into(RaycastResult& out, const TsdfVolume& volume, const Intrinsics& K, const Eigen::Isometry3f& T_wc,
+                  std::span<const int32_t> plane_remap = {}, RaycastOutputs outputs = RaycastOutputs::all());
+
 }  // namespace rrg

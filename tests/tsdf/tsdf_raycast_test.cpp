@@ -160,9 +160,27 @@ void expect_outputs_independent(const Device& device) {
     EXPECT_EQ(r->reflection.width() * r->reflection.height(), 0);
     EXPECT_EQ(r->reflection_mask.width() * r->reflection_mask.height(), 0);
   }
+  // raycast_into a result that holds another view's maps (of other sizes too) gives the same maps.
+  RaycastResult reused;
+  const Intrinsics half{kSmallK.fx / 2, kSmallK.fy / 2, kSmallK.cx / 2, kSmallK.cy / 2, kSmallK.width / 2, kSmallK.height / 2};
+  raycast_into(reused, volume, half, test::look_at({-0.4f, 0.1f, -1.0f}, {0, 0, 0}));
+  raycast_into(reused, volume, kSmallK, test::look_at({-0.4f, 0.1f, -1.0f}, {0, 0, 0}));
+  raycast_into(reused, volume, kSmallK, T, {}, RaycastOutputs::geometry());
+  EXPECT_TRUE(same(reused.depth, geometry.depth));
+  EXPECT_TRUE(same(reused.vertices, geometry.vertices));
+  EXPECT_TRUE(same(reused.normals, geometry.normals));
+  EXPECT_EQ(reused.colors.width() * reused.colors.height(), 0);
+  EXPECT_EQ(reused.color_variance.width() * reused.color_variance.height(), 0);
+  raycast_into(reused, volume, kSmallK, T);
+  EXPECT_TRUE(same(reused.depth, all.depth));
+  EXPECT_TRUE(same(reused.normals, all.normals));
+  EXPECT_TRUE(same(reused.colors, all.colors));
+  EXPECT_TRUE(same(reused.color_variance, all.color_variance));
+  EXPECT_TRUE(same(reused.plane_ids, all.plane_ids));
+  EXPECT_TRUE(same(reused.reflection_mask, all.reflection_mask));
 }
 
-// On every device (the kernel branches on the flags).
+// On every device (the kernel branches on the flags; raycast_into reuses device buffers).
 TEST(TsdfRaycast, OutputsLeftOutAreEmptyAndTheOthersUnchanged) {
   for (const Device& device : available_devices()) {
     SCOPED_TRACE(device.to_string());
