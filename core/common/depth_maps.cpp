@@ -7,16 +7,22 @@
 
 namespace rrg {
 
-VertexNormalMaps compute_vertex_normal_maps(const DeviceImage<float>& depth, const Intrinsics& K) {
+void compute_vertex_normal_maps_into(VertexNormalMaps& maps, const DeviceImage<float>& depth, const Intrinsics& K) {
   if (depth.width() != K.width || depth.height() != K.height)
     throw std::invalid_argument("compute_vertex_normal_maps: depth is " + std::to_string(depth.width()) +
                                 "x" + std::to_string(depth.height()) + " but intrinsics are " +
                                 K.to_string());
   const Device& dev = depth.device();
-  VertexNormalMaps maps{DeviceImage<Eigen::Vector3f>(depth.width(), depth.height(), dev),
-                        DeviceImage<Eigen::Vector3f>(depth.width(), depth.height(), dev)};
+  const int w = depth.width(), h = depth.height();
+  for (DeviceImage<Eigen::Vector3f>* img : {&maps.vertices, &maps.normals})
+    if (img->width() != w || img->height() != h || !(img->device() == dev)) *img = DeviceImage<Eigen::Vector3f>(w, h, dev);
   RRG_DISPATCH(dev, kernel::vertex_normal_maps_cpu(depth.view(), K, maps.vertices.view(), maps.normals.view()),
                kernel::vertex_normal_maps_cuda(depth.view(), K, maps.vertices.view(), maps.normals.view()));
+}
+
+VertexNormalMaps compute_vertex_normal_maps(const DeviceImage<float>& depth, const Intrinsics& K) {
+  VertexNormalMaps maps;
+  compute_vertex_normal_maps_into(maps, depth, K);
   return maps;
 }
 

@@ -16,5 +16,7 @@ struct VertexNormalMaps {
 
 // Throws std::invalid_argument when the depth size differs from the intrinsics' size.
 VertexNormalMaps compute_vertex_normal_maps(const DeviceImage<float>& depth, const Intrinsics& K);
+// The same into `out`, reusing its images when they already have the depth's size and device.
+void compute_vertex_normal_maps_into(VertexNormalMaps& out, const DeviceImage<float>& depth, const Intrinsics& K);
 
 }  // namespace rrg

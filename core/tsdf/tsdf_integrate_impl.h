@@ -2,17 +2,11 @@
 // The body of integrate() (tsdf_integrate.h), templated on the back-end tag and the colour type;
 // instantiated by tsdf_integrate_cpu.cpp and tsdf_integrate_cuda.cu.
 #include "core/common/camera.h"
+#include "core/tsdf/fusion_pixel.h"
 #include "core/tsdf/tsdf_integrate_device.h"
 
 namespace rrg::kernel {
 
-// What fusion needs of a depth pixel: the surface normal n (camera frame, facing the camera) and
-// the depth d; d = 0 where the pixel is not fused (depth outside [min, max], no normal because of
-// the image border or a hole, or a grazing view, cos θ < kMinCos). Computed once per pixel so that
-// the per-voxel test is one 16-byte load.
-struct FusionPixel {  // plain floats: bitwise copyable between devices
-  float nx = 0.0f, ny = 0.0f, nz = 0.0f, d = 0.0f;
-};
 inline constexpr float kMinCos = 0.2f;
 
 struct FusionPixelArgs {

@@ -81,7 +81,10 @@ MemoryUsage TsdfVolume::memory() const {
                    geometry_.size() * sizeof(TsdfVoxel) + attributes_.size() * sizeof(AttrVoxel) +
                    block_keys_.size() * (2 * sizeof(uint64_t) + sizeof(int32_t)) +
                    new_keys_.size() * sizeof(uint64_t) + new_slots_.size() * sizeof(int32_t) +
-                   active_.size() * sizeof(int32_t) + counters_.size() * sizeof(int32_t);
+                   active_.size() * sizeof(int32_t) + counters_.size() * sizeof(int32_t) +
+                   (frame_scratch_.maps.vertices.buffer().size() + frame_scratch_.maps.normals.buffer().size()) *
+                       sizeof(Eigen::Vector3f) +
+                   frame_scratch_.pixels.buffer().size() * sizeof(kernel::FusionPixel);
   for (const auto& [key, block] : host_blocks_) m.host_bytes += sizeof(BlockData) + block.voxels.size() * sizeof(Voxel) + sizeof(key);
   return m;
 }

@@ -12,6 +12,8 @@
 //   tsdf_io.h         versioned, checksummed save / load
 #include "core/common/buffer.h"
 #include "core/common/camera.h"
+#include "core/common/depth_maps.h"
+#include "core/tsdf/fusion_pixel.h"
 #include "core/tsdf/tsdf_params.h"
 #include "core/tsdf/voxel.h"
 #include "core/tsdf/tsdf_storage_impl.h"
@@ -28,7 +30,7 @@
 namespace rrg {
 
 struct MemoryUsage {
-  size_t device_bytes = 0;  // hash, block pool and per-block data on the volume's device
+  size_t device_bytes = 0;  // hash, block pool, per-block data and the per-frame scratch on the volume's device
   size_t host_bytes = 0;    // streamed-out blocks held in host memory
 };
 
@@ -89,6 +91,13 @@ class TsdfVolume {
   // Adds blocks that are not in the volume (files, streaming). Throws if one is already present.
   void insert_blocks(std::span<const BlockData> blocks);
   void set_version(uint64_t v) { version_ = v; }
+  // Per-frame images of integrate(), kept between frames so that fusing a frame allocates nothing
+  // once the first frame of a size has been fused: V_k^l, N_k^l and the per-pixel fusion data.
+  struct FrameScratch {
+    VertexNormalMaps maps;
+    DeviceImage<kernel::FusionPixel> pixels;
+  };
+  FrameScratch& frame_scratch() { return frame_scratch_; }
 
  private:
   void ensure_pool(int64_t blocks);       // pool capacity >= blocks (copying)
@@ -118,6 +127,7 @@ class TsdfVolume {
   Buffer<int32_t> new_slots_;
   Buffer<int32_t> active_;
   Buffer<int32_t> counters_;
+  FrameScratch frame_scratch_;
   std::unordered_map<uint64_t, BlockData> host_blocks_;  // streamed out, by key
 };
 
