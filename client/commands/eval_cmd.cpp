@@ -182,7 +182,7 @@ void run_mesh(const MeshOptions& o) {
     if (seen) {
       j["observed_by"] = o.observed_by;
       j["observed_fraction"] = seen->observed_fraction;
-      j["completion_whole_cm"] = seen->whole.completion_cm;
+      j["completion_whole_mesh_cm"] = seen->whole.completion_cm;
     }
     std::cout << j.dump(2) << "\n";
     return;

@@ -174,7 +174,7 @@ TEST(EvalCli, MeshObservedByADatasetScoresTheSurfaceItsFramesSaw) {
   EXPECT_NEAR(j.at("observed_fraction").get<double>(), 1.0 / 3.0, 0.01);  // the front only, not its back
   EXPECT_LT(j.at("completion_cm").get<double>(), 0.3);
   EXPECT_EQ(j.at("completion_ratio"), 1.0);
-  EXPECT_GT(j.at("completion_whole_cm").get<double>(), 100.0);  // the out-of-view square, ~10 m away
+  EXPECT_GT(j.at("completion_whole_mesh_cm").get<double>(), 100.0);  // the out-of-view square, ~10 m away
   r = run_rrg(cmd);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   j = nlohmann::json::parse(r.output);
