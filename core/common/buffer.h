@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <span>
 #include <stdexcept>
 #include <type_traits>
@@ -90,6 +91,14 @@ class Buffer {
   size_t size_ = 0;
 };
 
+// The first n elements of b on the host (all of them when n >= b.size()).
+template <class T>
+std::vector<T> download_prefix(const Buffer<T>& b, int64_t n) {
+  std::vector<T> out(size_t(std::clamp<int64_t>(n, 0, int64_t(b.size()))));
+  if (!out.empty()) mem::copy(out.data(), Device::cpu(), b.data(), b.device(), out.size() * sizeof(T));
+  return out;
+}
+
 template <class T>
 class DeviceImage {
  public:
@@ -105,6 +114,12 @@ class DeviceImage {
     Image<T> out(width_, height_);
     mem::copy(out.data(), Device::cpu(), buffer_.data(), buffer_.device(), buffer_.size() * sizeof(T));
     return out;
+  }
+
+  // Gives the image the size width x height on device, keeping its buffer (and pixels) when it has
+  // them already; loops that fill an image every frame call this instead of allocating anew.
+  void ensure(int width, int height, const Device& device) {
+    if (width_ != width || height_ != height || buffer_.device() != device) *this = DeviceImage(width, height, device);
   }
 
   int width() const { return width_; }

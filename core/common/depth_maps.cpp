@@ -13,9 +13,8 @@ void compute_vertex_normal_maps_into(VertexNormalMaps& maps, const DeviceImage<f
                                 "x" + std::to_string(depth.height()) + " but intrinsics are " +
                                 K.to_string());
   const Device& dev = depth.device();
-  const int w = depth.width(), h = depth.height();
-  for (DeviceImage<Eigen::Vector3f>* img : {&maps.vertices, &maps.normals})
-    if (img->width() != w || img->height() != h || !(img->device() == dev)) *img = DeviceImage<Eigen::Vector3f>(w, h, dev);
+  maps.vertices.ensure(depth.width(), depth.height(), dev);
+  maps.normals.ensure(depth.width(), depth.height(), dev);
   RRG_DISPATCH(dev, kernel::vertex_normal_maps_cpu(depth.view(), K, maps.vertices.view(), maps.normals.view()),
                kernel::vertex_normal_maps_cuda(depth.view(), K, maps.vertices.view(), maps.normals.view()));
 }

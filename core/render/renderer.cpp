@@ -37,11 +37,6 @@ void check_image(const DeviceImage<T>& img, const Intrinsics& K, const Device& d
                                 ", the renderer on " + device.to_string());
 }
 
-template <class T>
-void ensure_image(DeviceImage<T>& img, int w, int h, const Device& device) {
-  if (img.width() != w || img.height() != h || img.device() != device) img = DeviceImage<T>(w, h, device);
-}
-
 kernel::GaussianViews views_of(const GaussianSet& s) {
   return {s.means(), s.log_scales(), s.quats(), s.logit_opacities(), s.sh(), s.plane_ids()};
 }
@@ -141,8 +136,8 @@ void Renderer::render(const RenderCamera& camera, const GaussianSet& base, const
   raycast_ = &raycast;
   out_ = &out;
   const int w = K.width, h = K.height;
-  for (auto* img : {&out.C, &out.C_b, &out.C_g, &out.C_r}) ensure_image(*img, w, h, device_);
-  for (auto* img : {&out.D_b, &out.D_g, &out.W_g, &out.W_r}) ensure_image(*img, w, h, device_);
+  for (auto* img : {&out.C, &out.C_b, &out.C_g, &out.C_r}) img->ensure(w, h, device_);
+  for (auto* img : {&out.D_b, &out.D_g, &out.W_g, &out.W_r}) img->ensure(w, h, device_);
 
   const kernel::View vb = make_view(camera, base), vr = make_view(camera, reflection);
   const bool t = params_.time_stages;
@@ -175,8 +170,8 @@ void Renderer::render_reflection(const RenderCamera& camera, const GaussianSet& 
   check_image(I, K, device_, "I");
   base_set_ = nullptr;  // no backward() after this: its state is not a full render
   refl_set_ = &reflection;
-  ensure_image(out.C_r, K.width, K.height, device_);
-  ensure_image(out.W_r, K.width, K.height, device_);
+  out.C_r.ensure(K.width, K.height, device_);
+  out.W_r.ensure(K.width, K.height, device_);
   const kernel::View vr = make_view(camera, reflection);
   timings_.reflection_ms = timed(params_.time_stages, device_, [&] {
     project(vr, reflection, refl_);
@@ -201,8 +196,8 @@ void Renderer::reflection_forward(const kernel::View& view, const DeviceImage<in
   // Multi-pass: every group rendered alone over the whole image, then kept where I(u) == group.
   out.C_r.fill_zero();
   out.W_r.fill_zero();
-  ensure_image(group_C_, view.width, view.height, device_);
-  ensure_image(group_W_, view.width, view.height, device_);
+  group_C_.ensure(view.width, view.height, device_);
+  group_W_.ensure(view.width, view.height, device_);
   refl_entries_ = 0;
   for (int32_t k : reflection_groups()) {
     refl_.bins.build(view, splats, rects, set.plane_ids(), k, true, device_);
@@ -239,7 +234,7 @@ void Renderer::backward(const RenderUpstream& up, GaussianGrads& v_base, Gaussia
                           first(base_.v_splats, nb)};
     RRG_DISPATCH(device_, kernel::base_bwd_cpu(a), kernel::base_bwd_cuda(a));
     // composite: v_C_r = R v_C (+ v_C_r)
-    ensure_image(v_C_r_, K.width, K.height, device_);
+    v_C_r_.ensure(K.width, K.height, device_);
     const auto extra = has_v_C_r ? up.v_C_r.view() : ImageView<const Color>{};
     RRG_DISPATCH(device_, kernel::composite_bwd_cpu(up.v_C.view(), in.R.view(), extra, has_v_C_r, v_C_r_.view()),
                  kernel::composite_bwd_cuda(up.v_C.view(), in.R.view(), extra, has_v_C_r, v_C_r_.view()));

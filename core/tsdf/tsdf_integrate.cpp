@@ -42,7 +42,7 @@ int64_t integrate_any(TsdfVolume& volume, const DeviceImage<float>& depth, const
   const Eigen::Vector3f t_wc = T_wc.translation();
   const TsdfParams& p = volume.params();
   DeviceImage<kernel::FusionPixel>& pixels = scratch.pixels;
-  if (pixels.width() != K.width || pixels.height() != K.height) pixels = DeviceImage<kernel::FusionPixel>(K.width, K.height, dev);
+  pixels.ensure(K.width, K.height, dev);
   const kernel::FusionPixelArgs pa{depth.view(), maps.normals.view(), K, p.min_depth, p.max_depth, pixels.view()};
   RRG_DISPATCH(dev, kernel::fusion_pixels_cpu(pa), kernel::fusion_pixels_cuda(pa));
   const Span<const int32_t> active = volume.allocate_from_depth(depth, K, R_wc, t_wc);

@@ -63,13 +63,6 @@ void weld(TriangleMesh& mesh, const std::vector<Eigen::Vector4i>& keys) {
   for (auto& t : mesh.triangles) t = Eigen::Vector3i(index[size_t(t.x())], index[size_t(t.y())], index[size_t(t.z())]);
 }
 
-// The first 2m counts of the count pass (vertices, triangles per block).
-std::vector<int32_t> download_counts(const Buffer<int32_t>& counts, size_t m) {
-  std::vector<int32_t> out(2 * m);
-  mem::copy(out.data(), Device::cpu(), counts.data(), counts.device(), out.size() * sizeof(int32_t));
-  return out;
-}
-
 // Appends the device array's n elements to a host vector, copied once.
 template <class T>
 void append_from(std::vector<T>& out, const Buffer<T>& b, const Device& dev) {
@@ -95,7 +88,7 @@ TriangleMesh mesh_pool_blocks(const TsdfVolume& volume, const std::vector<int32_
                        volume.block_keys(), blocks_d.span(), table.span(), remap.span(), scratch.span(),
                        false, counts.span(), {}, 0, {}, {}, {}, {}, {}};
     RRG_DISPATCH(dev, kernel::mesh_blocks_cpu(a), kernel::mesh_blocks_cuda(a));
-    const std::vector<int32_t> c = download_counts(counts, m);
+    const std::vector<int32_t> c = download_prefix(counts, int64_t(2 * m));  // vertices, triangles per block
     std::vector<int64_t> offsets(2 * m);  // batch-local first vertex / triangle of each block
     int64_t nv = 0, nt = 0;
     for (size_t j = 0; j < m; ++j) {

@@ -7,16 +7,6 @@
 
 namespace rrg {
 
-namespace {
-
-// Gives img the size w x h on dev, keeping its buffer when it has it already.
-template <class T>
-void fit(DeviceImage<T>& img, int w, int h, const Device& dev) {
-  if (img.width() != w || img.height() != h || !(img.device() == dev)) img = DeviceImage<T>(w, h, dev);
-}
-
-}  // namespace
-
 void raycast_into(RaycastResult& r, const TsdfVolume& volume, const Intrinsics& K, const Eigen::Isometry3f& T_wc,
                   std::span<const int32_t> plane_remap, RaycastOutputs outputs) {
   if (!K.valid()) throw std::invalid_argument("raycast: invalid intrinsics " + K.to_string());
@@ -24,14 +14,14 @@ void raycast_into(RaycastResult& r, const TsdfVolume& volume, const Intrinsics& 
   const int w = K.width, h = K.height;
   const int wc = outputs.color ? w : 0, hc = outputs.color ? h : 0;
   const int wr = outputs.reflection ? w : 0, hr = outputs.reflection ? h : 0;
-  fit(r.depth, w, h, dev);
-  fit(r.vertices, w, h, dev);
-  fit(r.normals, w, h, dev);
-  fit(r.colors, wc, hc, dev);
-  fit(r.plane_ids, wr, hr, dev);
-  fit(r.reflection, wr, hr, dev);
-  fit(r.reflection_mask, wr, hr, dev);
-  fit(r.color_variance, wr, hr, dev);
+  r.depth.ensure(w, h, dev);
+  r.vertices.ensure(w, h, dev);
+  r.normals.ensure(w, h, dev);
+  r.colors.ensure(wc, hc, dev);
+  r.plane_ids.ensure(wr, hr, dev);
+  r.reflection.ensure(wr, hr, dev);
+  r.reflection_mask.ensure(wr, hr, dev);
+  r.color_variance.ensure(wr, hr, dev);
   const auto remap = Buffer<int32_t>::from_host(plane_remap, dev);
   const TsdfParams& p = volume.params();
   const int tiles_x = (w + kernel::kRangeTile - 1) / kernel::kRangeTile;

@@ -20,13 +20,6 @@ int64_t next_pow2(int64_t n) {
 }
 
 template <class T>
-std::vector<T> download_prefix(const Buffer<T>& b, int64_t n) {
-  std::vector<T> out(size_t(std::max<int64_t>(n, 0)));
-  if (n > 0) mem::copy(out.data(), Device::cpu(), b.data(), b.device(), size_t(n) * sizeof(T));
-  return out;
-}
-
-template <class T>
 void resize_keep(Buffer<T>& b, int64_t capacity, int64_t keep, const Device& device) {
   Buffer<T> bigger(size_t(capacity), device);
   if (keep > 0) mem::copy(bigger.data(), device, b.data(), device, size_t(keep) * sizeof(T));
