@@ -98,6 +98,9 @@ int64_t GaussianAdam::step(GaussianSet& set, const GaussianGrads& g) {
   if (g.v_means.size() != n || g.v_log_scales.size() != n || g.v_quats.size() != n || g.v_logit_opacities.size() != n ||
       g.v_sh.size() != n * size_t(sh_coeffs_))
     throw std::invalid_argument("GaussianAdam::step: gradients are not sized like the set");
+  if (!g.touched.empty() && g.touched.size() != n)
+    throw std::invalid_argument("GaussianAdam::step: `touched` has " + std::to_string(g.touched.size()) +
+                                " entries, the set " + std::to_string(n));
   if (n == 0) return 0;
   const kernel::AdamArgs a{params_.lr.mean, params_.lr.log_scale, params_.lr.opacity, params_.lr.rotation,
                            params_.lr.sh0,  params_.lr.sh_rest,   params_.beta1,      params_.beta2,
@@ -105,8 +108,8 @@ int64_t GaussianAdam::step(GaussianSet& set, const GaussianGrads& g) {
   const kernel::AdamTensors t{set.means(),         set.log_scales(),        set.quats(),
                               set.logit_opacities(), set.sh(),              g.v_means.span(),
                               g.v_log_scales.span(), g.v_quats.span(),      g.v_logit_opacities.span(),
-                              g.v_sh.span(),       m_.span(),               v_.span(),
-                              steps_.span()};
+                              g.v_sh.span(),       g.touched.span(),        m_.span(),
+                              v_.span(),           steps_.span()};
   int64_t updated = 0;
   RRG_DISPATCH(device_, updated = kernel::adam_step_cpu(int64_t(n), a, t),
                updated = kernel::adam_step_cuda(int64_t(n), a, t));

@@ -26,6 +26,7 @@ struct AdamTensors {
   Span<const Eigen::Vector4f> v_quats;
   Span<const float> v_logit_opacities;
   Span<const Eigen::Vector3f> v_sh;
+  Span<const uint8_t> touched;                 // [N] or empty (then the gradients are read)
   Span<float> m, v;                            // [N, stride]
   Span<int32_t> steps;                         // [N]
 };
@@ -40,17 +41,23 @@ RRG_HD inline void adam_update(float& p, float g, float& m, float& v, float lr, 
 
 template <class Backend>
 int64_t adam_step(Backend be, int64_t n, AdamArgs a, AdamTensors t) {
-  // The map updates Gaussian i (each index is mapped exactly once) and counts it when visible.
+  // The map updates Gaussian i (each index is mapped exactly once) and counts it when visible: some
+  // gradient non-zero, as `touched` records (read from the gradients when it is not given).
   return parallel_reduce(
       be, n, int64_t(0),
       [=] RRG_HD(int64_t i) -> int64_t {
         const int K = a.sh_coeffs;
-        bool visible = t.v_logit_opacities[i] != 0.0f;
-        for (int c = 0; c < 3; ++c)
-          visible = visible || t.v_means[i][c] != 0.0f || t.v_log_scales[i][c] != 0.0f;
-        for (int c = 0; c < 4; ++c) visible = visible || t.v_quats[i][c] != 0.0f;
-        for (int k = 0; k < K && !visible; ++k)
-          for (int c = 0; c < 3; ++c) visible = visible || t.v_sh[i * K + k][c] != 0.0f;
+        bool visible = false;
+        if (!t.touched.empty()) {
+          visible = t.touched[i] != 0;
+        } else {
+          visible = t.v_logit_opacities[i] != 0.0f;
+          for (int c = 0; c < 3; ++c)
+            visible = visible || t.v_means[i][c] != 0.0f || t.v_log_scales[i][c] != 0.0f;
+          for (int c = 0; c < 4; ++c) visible = visible || t.v_quats[i][c] != 0.0f;
+          for (int k = 0; k < K && !visible; ++k)
+            for (int c = 0; c < 3; ++c) visible = visible || t.v_sh[i * K + k][c] != 0.0f;
+        }
         if (!visible) return 0;
         const int32_t step = t.steps[i] + 1;
         t.steps[i] = step;

@@ -13,10 +13,16 @@ struct GaussianGrads {
   Buffer<Eigen::Vector4f> v_quats;            // [N, 4] w.r.t. the stored (unnormalised) quaternion
   Buffer<float> v_logit_opacities;            // [N]
   Buffer<Eigen::Vector3f> v_sh;               // [N, K, 3]
+  // [N] 1 where some gradient of Gaussian i is non-zero (the Gaussians a view saw), 0 elsewhere;
+  // written by the renderer's backward. Empty when unknown: GaussianAdam then reads the gradients.
+  Buffer<uint8_t> touched;
 
   // Zero gradients for n Gaussians with k SH coefficients each, on device (reuses memory when the
-  // sizes already match).
+  // sizes already match); `touched` is left empty.
   void reset(size_t n, int k, const Device& device);
+  // Buffers (touched included) for n Gaussians with k SH coefficients, contents left as they are:
+  // for a writer that sets every entry (the renderer's backward). Reuses memory when sizes match.
+  void resize(size_t n, int k, const Device& device);
 };
 
 }  // namespace rrg

@@ -61,60 +61,72 @@ T ssim(Backend be, int w, int h, Span<const T> x, Span<const T> y, Span<T> v_x, 
   T* hs = abc + n * 9;               // [N, 3, 3] horizontal sums of a, b, c
   T* smap = hs + n * 9;              // [N, 3] SSIM map
   constexpr int R = kSsimRadius;
-  parallel_for(be, n * 3, [=] RRG_HD(int64_t i) {
-    const int64_t p = i / 3;
-    const int ch = int(i % 3), px = int(p % w), py = int(p / w);
-    T s[5] = {T(0), T(0), T(0), T(0), T(0)};
-    for (int k = -R; k <= R; ++k) {
-      const int xx = px + k;
-      if (xx < 0 || xx >= w) continue;
-      const int64_t j = (int64_t(py) * w + xx) * 3 + ch;
-      const T g = win.g[k + R], a = x[j], b = y[j];
-      s[0] += g * a; s[1] += g * b; s[2] += g * a * a; s[3] += g * b * b; s[4] += g * a * b;
+  // One work item per pixel, its three channels together: the window's bounds and the index math
+  // are done once per pixel. Per channel the sums run over the taps in the same order as a loop per
+  // channel would, so the result does not depend on this grouping.
+  parallel_for(be, n, [=] RRG_HD(int64_t p) {
+    const int px = int(p % w), py = int(p / w);
+    const int k0 = px - R < 0 ? -px : -R, k1 = px + R >= w ? w - 1 - px : R;
+    T s[3][5] = {};
+    for (int k = k0; k <= k1; ++k) {
+      const int64_t j = (int64_t(py) * w + px + k) * 3;
+      const T g = win.g[k + R];
+      for (int ch = 0; ch < 3; ++ch) {
+        const T a = x[j + ch], b = y[j + ch];
+        s[ch][0] += g * a; s[ch][1] += g * b; s[ch][2] += g * a * a; s[ch][3] += g * b * b; s[ch][4] += g * a * b;
+      }
     }
-    for (int m = 0; m < 5; ++m) hm[i * 5 + m] = s[m];
+    for (int ch = 0; ch < 3; ++ch)
+      for (int m = 0; m < 5; ++m) hm[(p * 3 + ch) * 5 + m] = s[ch][m];
   });
-  parallel_for(be, n * 3, [=] RRG_HD(int64_t i) {
-    const int64_t p = i / 3;
-    const int ch = int(i % 3), px = int(p % w), py = int(p / w);
-    T s[5] = {T(0), T(0), T(0), T(0), T(0)};
-    for (int k = -R; k <= R; ++k) {
-      const int yy = py + k;
-      if (yy < 0 || yy >= h) continue;
-      const int64_t j = (int64_t(yy) * w + px) * 3 + ch;
-      for (int m = 0; m < 5; ++m) s[m] += win.g[k + R] * hm[j * 5 + m];
+  parallel_for(be, n, [=] RRG_HD(int64_t p) {
+    const int px = int(p % w), py = int(p / w);
+    const int k0 = py - R < 0 ? -py : -R, k1 = py + R >= h ? h - 1 - py : R;
+    T s[3][5] = {};
+    for (int k = k0; k <= k1; ++k) {
+      const int64_t j = (int64_t(py + k) * w + px) * 3;
+      const T g = win.g[k + R];
+      for (int ch = 0; ch < 3; ++ch)
+        for (int m = 0; m < 5; ++m) s[ch][m] += g * hm[(j + ch) * 5 + m];
     }
-    T a, b, c;
-    smap[i] = ssim_from_moments(s[0], s[1], s[2], s[3], s[4], win.c1, win.c2, &a, &b, &c);
-    abc[i * 3 + 0] = a; abc[i * 3 + 1] = b; abc[i * 3 + 2] = c;
+    for (int ch = 0; ch < 3; ++ch) {
+      const int64_t i = p * 3 + ch;
+      T a, b, c;
+      smap[i] = ssim_from_moments(s[ch][0], s[ch][1], s[ch][2], s[ch][3], s[ch][4], win.c1, win.c2, &a, &b, &c);
+      abc[i * 3 + 0] = a; abc[i * 3 + 1] = b; abc[i * 3 + 2] = c;
+    }
   });
   const T total = parallel_reduce(
       be, n * 3, T(0), [=] RRG_HD(int64_t i) { return smap[i]; }, [] RRG_HD(T a, T b) { return a + b; });
   if (!v_x.empty()) {
-    parallel_for(be, n * 3, [=] RRG_HD(int64_t i) {
-      const int64_t p = i / 3;
-      const int ch = int(i % 3), px = int(p % w), py = int(p / w);
-      T s[3] = {T(0), T(0), T(0)};
-      for (int k = -R; k <= R; ++k) {
-        const int xx = px + k;
-        if (xx < 0 || xx >= w) continue;
-        const int64_t j = (int64_t(py) * w + xx) * 3 + ch;
-        for (int m = 0; m < 3; ++m) s[m] += win.g[k + R] * abc[j * 3 + m];
+    parallel_for(be, n, [=] RRG_HD(int64_t p) {
+      const int px = int(p % w), py = int(p / w);
+      const int k0 = px - R < 0 ? -px : -R, k1 = px + R >= w ? w - 1 - px : R;
+      T s[3][3] = {};
+      for (int k = k0; k <= k1; ++k) {
+        const int64_t j = (int64_t(py) * w + px + k) * 3;
+        const T g = win.g[k + R];
+        for (int ch = 0; ch < 3; ++ch)
+          for (int m = 0; m < 3; ++m) s[ch][m] += g * abc[(j + ch) * 3 + m];
       }
-      for (int m = 0; m < 3; ++m) hs[i * 3 + m] = s[m];
+      for (int ch = 0; ch < 3; ++ch)
+        for (int m = 0; m < 3; ++m) hs[(p * 3 + ch) * 3 + m] = s[ch][m];
     });
     const T scale = weight / T(n * 3);
-    parallel_for(be, n * 3, [=] RRG_HD(int64_t i) {
-      const int64_t p = i / 3;
-      const int ch = int(i % 3), px = int(p % w), py = int(p / w);
-      T s[3] = {T(0), T(0), T(0)};
-      for (int k = -R; k <= R; ++k) {
-        const int yy = py + k;
-        if (yy < 0 || yy >= h) continue;
-        const int64_t j = (int64_t(yy) * w + px) * 3 + ch;
-        for (int m = 0; m < 3; ++m) s[m] += win.g[k + R] * hs[j * 3 + m];
+    parallel_for(be, n, [=] RRG_HD(int64_t p) {
+      const int px = int(p % w), py = int(p / w);
+      const int k0 = py - R < 0 ? -py : -R, k1 = py + R >= h ? h - 1 - py : R;
+      T s[3][3] = {};
+      for (int k = k0; k <= k1; ++k) {
+        const int64_t j = (int64_t(py + k) * w + px) * 3;
+        const T g = win.g[k + R];
+        for (int ch = 0; ch < 3; ++ch)
+          for (int m = 0; m < 3; ++m) s[ch][m] += g * hs[(j + ch) * 3 + m];
       }
-      v_x[i] += scale * (s[0] + T(2) * x[i] * s[1] + y[i] * s[2]);
+      for (int ch = 0; ch < 3; ++ch) {
+        const int64_t i = p * 3 + ch;
+        v_x[i] += scale * (s[ch][0] + T(2) * x[i] * s[ch][1] + y[i] * s[ch][2]);
+      }
     });
   }
   return total / T(n * 3);

@@ -3,6 +3,7 @@
 // project_cpu.cpp and project_cuda.cu.
 #include "core/common/atomics.h"
 #include "core/render/project_device.h"
+#include "core/render/splat_grad_ops.h"
 #include "core/render/stage_args.h"
 
 #include <cstring>
@@ -80,19 +81,31 @@ void tile_ranges(Backend b, Span<const uint64_t> keys, bool with_depth, Span<Til
 template <class Backend>
 void project_bwd(Backend b, View view, GaussianViews g, Span<const SplatGrad> v_splats, GaussianGradViews v) {
   parallel_for(b, g.means.size, [=] RRG_HD(int64_t i) {
-    const auto gi = gaussian_at<Eigen::Vector3f>(g, i, view.sh_stride);
     Vec3<float> v_sh_local[kMaxShCoeffs];
     for (int k = 0; k < kMaxShCoeffs; ++k) v_sh_local[k].setZero();
-    Vec3<float> v_mean, v_log_scale;
-    Vec4<float> v_quat;
+    Vec3<float> v_mean = Vec3<float>::Zero(), v_log_scale = Vec3<float>::Zero();
+    Vec4<float> v_quat = Vec4<float>::Zero();
     float v_logit = 0;
-    project_gaussian_bwd<float, Eigen::Vector3f>(view, gi, v_splats[i], v_mean, v_log_scale, v_quat, v_logit,
-                                                 v_sh_local);
+    // A splat no pixel sent gradient to (most of the map lies outside any one view) has zero
+    // parameter gradients: written as such without redoing its projection.
+    const bool any = !is_zero(v_splats[i]);
+    if (any) {
+      const auto gi = gaussian_at<Eigen::Vector3f>(g, i, view.sh_stride);
+      project_gaussian_bwd<float, Eigen::Vector3f>(view, gi, v_splats[i], v_mean, v_log_scale, v_quat, v_logit,
+                                                   v_sh_local);
+    }
     v.v_means[i] = v_mean;
     v.v_log_scales[i] = v_log_scale;
     v.v_quats[i] = v_quat;
     v.v_logit_opacities[i] = v_logit;
-    for (int k = 0; k < view.sh_stride; ++k) v.v_sh[i * view.sh_stride + k] = v_sh_local[k];
+    bool nonzero = v_logit != 0.0f;
+    for (int c = 0; c < 3; ++c) nonzero = nonzero || v_mean[c] != 0.0f || v_log_scale[c] != 0.0f;
+    for (int c = 0; c < 4; ++c) nonzero = nonzero || v_quat[c] != 0.0f;
+    for (int k = 0; k < view.sh_stride; ++k) {
+      v.v_sh[i * view.sh_stride + k] = v_sh_local[k];
+      for (int c = 0; c < 3; ++c) nonzero = nonzero || v_sh_local[k][c] != 0.0f;
+    }
+    v.touched[i] = nonzero ? 1 : 0;
   });
 }
 

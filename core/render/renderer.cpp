@@ -42,7 +42,8 @@ kernel::GaussianViews views_of(const GaussianSet& s) {
 }
 
 kernel::GaussianGradViews views_of(GaussianGrads& g) {
-  return {g.v_means.span(), g.v_log_scales.span(), g.v_quats.span(), g.v_logit_opacities.span(), g.v_sh.span()};
+  return {g.v_means.span(), g.v_log_scales.span(), g.v_quats.span(), g.v_logit_opacities.span(), g.v_sh.span(),
+          g.touched.span()};
 }
 
 template <class T>
@@ -239,9 +240,9 @@ void Renderer::backward(const RenderUpstream& up, GaussianGrads& v_base, Gaussia
     RRG_DISPATCH(device_, kernel::composite_bwd_cpu(up.v_C.view(), in.R.view(), extra, has_v_C_r, v_C_r_.view()),
                  kernel::composite_bwd_cuda(up.v_C.view(), in.R.view(), extra, has_v_C_r, v_C_r_.view()));
     reflection_backward(vr, v_C_r_);
-    // splat gradients -> Gaussian parameters
-    v_base.reset(size_t(nb), base.sh_coeffs(), device_);
-    v_reflection.reset(size_t(nr), refl.sh_coeffs(), device_);
+    // splat gradients -> Gaussian parameters (project_bwd writes every entry, `touched` included)
+    v_base.resize(size_t(nb), base.sh_coeffs(), device_);
+    v_reflection.resize(size_t(nr), refl.sh_coeffs(), device_);
     RRG_DISPATCH(device_, kernel::project_bwd_cpu(vb, views_of(base), first(base_.v_splats, nb), views_of(v_base)),
                  kernel::project_bwd_cuda(vb, views_of(base), first(base_.v_splats, nb), views_of(v_base)));
     RRG_DISPATCH(device_,

@@ -22,6 +22,7 @@ struct GaussianGradViews {
   Span<Eigen::Vector4f> v_quats;                // [N, 4]
   Span<float> v_logit_opacities;                // [N]
   Span<Eigen::Vector3f> v_sh;                   // [N, K, 3]
+  Span<uint8_t> touched;                        // [N] 1 where a gradient above is non-zero
 };
 
 // Sorted tile lists: entries values[ranges[t].begin .. ranges[t].end) of tile t are Gaussian indices.

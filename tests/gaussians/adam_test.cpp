@@ -103,6 +103,53 @@ TEST(Adam, KnownAnswerVisibilityAndParity) {
   EXPECT_EQ(got[3 * per + 2], 2);
 }
 
+// The renderer's backward marks the Gaussians with a non-zero gradient in `touched`; Adam then
+// updates exactly those, without reading their gradients. A mark decides: a Gaussian marked 0 stays
+// put even with gradients, and the result with the marks equals the one read from the gradients.
+TEST(Adam, TouchedMarksDecideWhichGaussiansMove) {
+  const int degree = 1, K = 4;
+  for (const Device& dev : available_devices()) {
+    SCOPED_TRACE(dev.to_string());
+    auto run = [&](const std::vector<uint8_t>* marks) {
+      GaussianSet set = GaussianSet::from_host(three(degree), dev);
+      GaussianAdam adam(AdamParams{AdamLearningRates::base()}, degree, dev);
+      adam.grow(set.size());
+      GaussianGrads g;
+      fill_grads(g, 3, K, 1.0f, dev);
+      if (marks) {
+        g.touched = Buffer<uint8_t>(3, dev);
+        g.touched.copy_from_host(*marks);
+      }
+      const int64_t updated = adam.step(set, g);
+      return std::pair{updated, set.to_host()};
+    };
+    const std::vector<uint8_t> exact{1, 0, 1}, only_first{1, 0, 0};
+    const auto [n_scan, scan] = run(nullptr);
+    const auto [n_marked, marked] = run(&exact);
+    const auto [n_first, first] = run(&only_first);
+    EXPECT_EQ(n_scan, 2);
+    EXPECT_EQ(n_marked, 2);
+    EXPECT_EQ(n_first, 1);
+    for (size_t i = 0; i < 3; ++i) {
+      EXPECT_EQ(scan.means[i], marked.means[i]) << i;
+      EXPECT_EQ(scan.log_scales[i], marked.log_scales[i]) << i;
+      EXPECT_EQ(scan.logit_opacities[i], marked.logit_opacities[i]) << i;
+    }
+    EXPECT_EQ(first.means[0], scan.means[0]);
+    EXPECT_NE(scan.means[2], three(degree).means[2]);     // moved when marked
+    EXPECT_EQ(first.means[2], three(degree).means[2]);    // stays when not, gradients or not
+    EXPECT_EQ(first.logit_opacities[2], three(degree).logit_opacities[2]);
+    // a mark array of the wrong size is an error, not a read past its end
+    GaussianSet set = GaussianSet::from_host(three(degree), dev);
+    GaussianAdam adam(AdamParams{}, degree, dev);
+    adam.grow(set.size());
+    GaussianGrads g;
+    fill_grads(g, 3, K, 1.0f, dev);
+    g.touched = Buffer<uint8_t>(2, dev);
+    EXPECT_THROW(adam.step(set, g), std::invalid_argument);
+  }
+}
+
 TEST(Adam, StateFollowsPruneAndAppend) {
   const int degree = 0, K = 1;
   for (const Device& dev : available_devices()) {

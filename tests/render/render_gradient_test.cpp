@@ -177,6 +177,49 @@ TEST(RenderGradient, MultiPassGradientsEqualGroupedGradients) {
   for (size_t i = 0; i < grouped.size(); ++i) ASSERT_NEAR(grouped[i], multi[i], 1e-5 + 1e-5 * std::abs(grouped[i])) << i;
 }
 
+// `touched` marks exactly the Gaussians with a non-zero gradient (what GaussianAdam updates): one
+// appended behind the camera and one far outside the view get 0 and all-zero gradients.
+TEST(RenderGradient, TouchedMarksExactlyTheGaussiansWithAGradient) {
+  SmallScene s = small_scene(11);
+  const size_t n0 = s.base.size();
+  s.base.resize(n0 + 2);
+  for (size_t i = n0; i < n0 + 2; ++i) {
+    s.base.log_scales[i] = Eigen::Vector3f::Constant(-3.0f);
+    s.base.logit_opacities[i] = 2.0f;
+  }
+  s.base.means[n0] = s.camera.T_wc * Eigen::Vector3f(0.0f, 0.0f, -1.0f);     // behind the camera
+  s.base.means[n0 + 1] = s.camera.T_wc * Eigen::Vector3f(50.0f, 0.0f, 1.0f);  // far to the side
+  const HostUpstream up = random_upstream(s.camera.K.width, s.camera.K.height, 12);
+  for (const Device& device : available_devices()) {
+    SCOPED_TRACE(device.to_string());
+    const auto base = GaussianSet::from_host(s.base, device);
+    const auto refl = GaussianSet::from_host(s.refl, device);
+    const auto in = to_device(s.raycast, device);
+    Renderer r(device, RenderParams{});
+    RenderOutputs out;
+    r.render(s.camera, base, refl, in, out);
+    GaussianGrads gb, gr;
+    r.backward(to_device(up, device), gb, gr);
+    for (const auto* g : {&gb, &gr}) {
+      const GaussianHost h = to_host_grads(*g, g == &gb ? s.base.sh_degree : s.refl.sh_degree);
+      const std::vector<uint8_t> touched = g->touched.to_host();
+      ASSERT_EQ(touched.size(), h.size());
+      size_t marked = 0;
+      for (size_t i = 0; i < h.size(); ++i) {
+        bool nonzero = h.logit_opacities[i] != 0.0f || !h.means[i].isZero(0.0f) || !h.log_scales[i].isZero(0.0f) ||
+                       !h.quats[i].isZero(0.0f);
+        for (int k = 0; k < h.sh_coeffs(); ++k) nonzero = nonzero || !h.sh[i * size_t(h.sh_coeffs()) + size_t(k)].isZero(0.0f);
+        EXPECT_EQ(touched[i] != 0, nonzero) << i;
+        marked += touched[i];
+      }
+      EXPECT_GT(marked, 0u);
+    }
+    const std::vector<uint8_t> tb = gb.touched.to_host();
+    EXPECT_EQ(tb[n0], 0);
+    EXPECT_EQ(tb[n0 + 1], 0);
+  }
+}
+
 TEST(RenderGradient, BackwardParityOnEveryDevice) {
   const SmallScene s = small_scene(31, 80, 56);
   const HostUpstream up = random_upstream(80, 56, 32);
