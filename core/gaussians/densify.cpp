@@ -192,7 +192,7 @@ GaussianHost densify_reflection(const DensifyView& v, std::span<const Reflective
   const bool mirrored = p.reflection_mirrored_depth && v.virtual_depth != nullptr;
   if (mirrored) check_image(v.virtual_depth, v.K, "virtual_depth");
   // Pixels left after each test, in order (the debug log shows where candidates are lost).
-  int64_t on_plane = 0, masked = 0, wrong = 0, varying = 0, uncovered = 0, sampled = 0;
+  int64_t on_plane = 0, masked = 0, wrong = 0, varying = 0, uncovered = 0, sampled = 0, at_mirrored = 0;
   for (int y = 0; y < v.K.height; ++y)
     for (int x = 0; x < v.K.width; ++x) {
       const int32_t id = (*v.I)(x, y);
@@ -229,6 +229,7 @@ GaussianHost densify_reflection(const DensifyView& v, std::span<const Reflective
           nrm.push_back(n);
           col.push_back(c);
           ids.push_back(id);
+          ++at_mirrored;
           continue;
         }
       }
@@ -242,9 +243,9 @@ GaussianHost densify_reflection(const DensifyView& v, std::span<const Reflective
       }
     }
   spdlog::debug("densify_reflection: {} reflective plane(s); pixels on them {}, with R = 1 {}, error > {} {}, "
-                "C_var > {} {}, W_r < {} {}, sampled {}",
+                "C_var > {} {}, W_r < {} {}, sampled {} ({} at the mirrored surface)",
                 planes.size(), on_plane, masked, p.reflection_error, wrong, p.variance, varying, p.reflection_weight,
-                uncovered, sampled);
+                uncovered, sampled, at_mirrored);
   return init_gaussians(pts, nrm, col, ids, p, p.reflection_min_init_scale, p.reflection_max_init_scale, sh_degree);
 }
 

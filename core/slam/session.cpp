@@ -132,7 +132,7 @@ const SessionConfig& Session::config() const { return impl_->config; }
 RaycastResult Session::Impl::locked_raycast(const Intrinsics& K_, const Eigen::Isometry3f& T_wc,
                                             RaycastOutputs outputs) const {
   const std::vector<int32_t> ids = remap_copy();
-  std::lock_guard lock(volume_mutex);
+  std::shared_lock lock(volume_mutex);
   return raycast(volume, K_, T_wc, ids, outputs);
 }
 
@@ -269,7 +269,7 @@ FrameReport Session::process(const SessionFrame& frame) {
     if (identify) s.identify(frame, report.T_wc, report, plane_ids, mask);
     const auto tf = Clock::now();
     {
-      std::lock_guard lock(s.volume_mutex);
+      std::unique_lock lock(s.volume_mutex);  // the one writer
       const ReflectionObservation obs{&plane_ids, &mask, s.remap};  // written by this thread only
       // D_k after the bilateral filter: at fine resolutions the raw depth's noise exceeds the pixel
       // spacing and fusion's normals (point-to-plane sdf, grazing test) would drop the surface

@@ -3,8 +3,10 @@
 // renders, meshes, status) and session_snapshot.cpp (save / load). Not part of the API.
 //
 // Locks, always taken in this order when nested:
-//   volume_mutex   the TSDF: fusion (process thread), raycasts of tracking, identification,
-//                  mapping (mapping thread) and renders (any thread);
+//   volume_mutex   the TSDF, a readers-writer lock: fusion (process thread) writes and holds it
+//                  alone; raycasts (tracking, identification, the mapping thread's frames, renders
+//                  from any thread), meshes, status and saves only read it and share it, so the
+//                  mapping thread's raycasts run beside the process thread's;
 //   state_mutex    trajectory, reports, status fields, reflective planes.
 // The mapper publishes immutable snapshots for renders (core/slam/mapper.h), so rendering never
 // waits for a mapping step.
@@ -19,6 +21,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <mutex>
+#include <shared_mutex>
 #include <thread>
 
 namespace rrg {
@@ -26,16 +29,16 @@ namespace rrg {
 // ICP's model source with the raycast taken under the volume lock.
 class LockedModelSource final : public ModelSource {
  public:
-  LockedModelSource(const TsdfVolume& volume, const Intrinsics& K, std::mutex& m) : inner_(volume, K), mutex_(m) {}
+  LockedModelSource(const TsdfVolume& volume, const Intrinsics& K, std::shared_mutex& m) : inner_(volume, K), mutex_(m) {}
   IcpModel model_at(const Eigen::Isometry3f& T_wc) override {
-    std::lock_guard lock(mutex_);
+    std::shared_lock lock(mutex_);  // the cached maps of inner_ are the process thread's alone
     return inner_.model_at(T_wc);
   }
   void invalidate() { inner_.invalidate(); }
 
  private:
   TsdfModelSource inner_;
-  std::mutex& mutex_;
+  std::shared_mutex& mutex_;
 };
 
 // The mapping thread: runs one step at a time when asked; wait() blocks until it is idle.
@@ -76,7 +79,7 @@ struct Session::Impl {
 
   SessionConfig config;
   Intrinsics K;
-  mutable std::mutex volume_mutex;
+  mutable std::shared_mutex volume_mutex;
   TsdfVolume volume;
   LockedModelSource model;
   Tracker tracker;

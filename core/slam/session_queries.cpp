@@ -29,7 +29,7 @@ SessionView Session::render(const Intrinsics& K, const Eigen::Isometry3f& T_wc) 
 TriangleMesh Session::mesh(uint64_t changed_since) const {
   const Impl& s = *impl_;
   const std::vector<int32_t> remap = s.remap_copy();
-  std::lock_guard lock(s.volume_mutex);
+  std::shared_lock lock(s.volume_mutex);
   if (changed_since == 0) return extract_mesh(s.volume, remap);
   const auto blocks = s.volume.changed_blocks(changed_since);
   return extract_mesh(s.volume, blocks, remap);
@@ -37,14 +37,14 @@ TriangleMesh Session::mesh(uint64_t changed_since) const {
 
 Session::ChangedBlocks Session::changed_blocks(uint64_t since) const {
   const Impl& s = *impl_;
-  std::lock_guard lock(s.volume_mutex);
+  std::shared_lock lock(s.volume_mutex);
   return {s.volume.changed_blocks(since), s.volume.version()};
 }
 
 TriangleMesh Session::mesh_of_blocks(const std::vector<Eigen::Vector3i>& blocks) const {
   const Impl& s = *impl_;
   const std::vector<int32_t> remap = s.remap_copy();
-  std::lock_guard lock(s.volume_mutex);
+  std::shared_lock lock(s.volume_mutex);
   return extract_mesh(s.volume, blocks, remap);
 }
 
@@ -70,7 +70,7 @@ SessionStatus Session::status() const {
   const Impl& s = *impl_;
   SessionStatus st;
   {
-    std::lock_guard lock(s.volume_mutex);
+    std::shared_lock lock(s.volume_mutex);
     st.tsdf_blocks = s.volume.num_blocks() + s.volume.num_host_blocks();
     const MemoryUsage m = s.volume.memory();
     st.device_bytes = m.device_bytes;

@@ -165,7 +165,7 @@ void Session::save(const std::filesystem::path& file) const {
     w.put<int64_t>(s.mapping.steps);
   }
   {
-    std::lock_guard lock(s.volume_mutex);
+    std::shared_lock lock(s.volume_mutex);
     w.put_bytes(volume_bytes(s.volume, file));
   }
   put_gaussians(w, s.mapper.base_host());
