@@ -28,3 +28,14 @@
 #else
 #define RRG_UNROLL
 #endif
+
+// RRG_PREFETCH(p): ask the CPU's caches for the line of p ahead of a read the code will do after
+// other work (a hint: no effect on results). Nothing on the GPU, where the warp scheduler hides
+// load latency by switching warps.
+#if defined(__CUDA_ARCH__)
+#define RRG_PREFETCH(p) ((void)0)
+#elif defined(__GNUC__)
+#define RRG_PREFETCH(p) __builtin_prefetch((p), 0, 3)
+#else
+#define RRG_PREFETCH(p) ((void)(p))
+#endif

@@ -182,6 +182,10 @@ RRG_HD inline SurfaceSample shade(const VolumeView& vol, const Eigen::Vector3f& 
     if (corner[c] < 0) return out;  // a corner of the cell unobserved: no trilinear value here
     tc[c] = voxel_codec::decode_tsdf(vol.geometry[corner[c]].tsdf);
   }
+  // The corners' attributes (another array than the TSDF the march has been reading, so not in
+  // the caches yet): requested now, read after the 24 neighbours below.
+  if (want_color || want_reflection)
+    for (int c = 0; c < 8; ++c) RRG_PREFETCH(&vol.attributes[corner[c]]);
   bool neighbours = true;  // all 24 outward neighbours observed
   RRG_UNROLL
   for (int c = 0; c < 8; ++c) {
