@@ -106,6 +106,13 @@ void DensifyParams::validate() const {
         "reflection_min_init_scale", reflection_min_init_scale);
   check(flatten > 0 && flatten <= 1, "flatten", flatten);
   check(init_opacity > 0 && init_opacity < 1, "init_opacity", init_opacity);
+  check(reflection_sample_opacity >= 0 && reflection_sample_opacity < 1, "reflection_sample_opacity",
+        reflection_sample_opacity);
+}
+
+float DensifyParams::reflection_sample_alpha() const {
+  if (reflection_sample_opacity > 0) return reflection_sample_opacity;
+  return 1.0f - std::pow(1.0f - init_opacity, 1.0f / float(reflection_samples));
 }
 
 GaussianHost init_gaussians(std::span<const Eigen::Vector3f> points, std::span<const Eigen::Vector3f> normals,
@@ -186,6 +193,7 @@ GaussianHost densify_reflection(const DensifyView& v, std::span<const Reflective
   std::vector<Eigen::Vector3f> pts, nrm;
   std::vector<Color> col;
   std::vector<int32_t> ids;
+  std::vector<uint8_t> on_ray;  // 1: one of the S samples along a ray; 0: at the mirrored surface
   const Eigen::Vector3f o = v.T_wc.translation();
   const Eigen::Matrix3f R_wc = v.T_wc.linear();
   const int S = p.reflection_samples;
@@ -229,6 +237,7 @@ GaussianHost densify_reflection(const DensifyView& v, std::span<const Reflective
           nrm.push_back(n);
           col.push_back(c);
           ids.push_back(id);
+          on_ray.push_back(0);
           ++at_mirrored;
           continue;
         }
@@ -240,13 +249,19 @@ GaussianHost densify_reflection(const DensifyView& v, std::span<const Reflective
         nrm.push_back(n);
         col.push_back(c);
         ids.push_back(id);
+        on_ray.push_back(1);
       }
     }
   spdlog::debug("densify_reflection: {} reflective plane(s); pixels on them {}, with R = 1 {}, error > {} {}, "
                 "C_var > {} {}, W_r < {} {}, sampled {} ({} at the mirrored surface)",
                 planes.size(), on_plane, masked, p.reflection_error, wrong, p.variance, varying, p.reflection_weight,
                 uncovered, sampled, at_mirrored);
-  return init_gaussians(pts, nrm, col, ids, p, p.reflection_min_init_scale, p.reflection_max_init_scale, sh_degree);
+  GaussianHost h = init_gaussians(pts, nrm, col, ids, p, p.reflection_min_init_scale, p.reflection_max_init_scale, sh_degree);
+  const float alpha = p.reflection_sample_alpha();
+  const float logit = std::log(alpha / (1.0f - alpha));
+  for (size_t i = 0; i < h.size(); ++i)
+    if (on_ray[i]) h.logit_opacities[i] = logit;
+  return h;
 }
 
 }  // namespace rrg

@@ -52,6 +52,11 @@ struct DensifyParams {
   float reflection_min_init_scale = 0.0075f;  // 1.5 x the reflection prune min scale (0.005)
   float flatten = 0.1f;              // normal-axis scale / tangential scale
   float init_opacity = 0.5f;
+  // Opacity of each of the reflection_samples Gaussians along one reflection ray. 0 = derived: the
+  // S samples together are as opaque as one new Gaussian, 1 − (1 − init_opacity)^(1/S), so that
+  // the samples behind the first still receive light and gradient. (A Gaussian at the mirrored
+  // surface is one surface and gets init_opacity.)
+  float reflection_sample_opacity = 0.5f;
   bool reflection_residual_color = false;  // reflection colour max(C_gt − C_b, 0) instead of C_gt
   bool base_leaves_reflections = false;    // see densify_base (off: on mirror_room it cost 0.4 dB)
   // Reflection positions: false = the paper's samples along the ray 2–8 m past the plane; true =
@@ -65,6 +70,7 @@ struct DensifyParams {
   // pixels +1.3 dB over base only with the gate, +2.4 dB without it, both with a 10 cm scale cap).
   bool reflection_variance_gate = false;
   void validate() const;             // throws std::invalid_argument naming the bad field
+  float reflection_sample_alpha() const;  // reflection_sample_opacity, or the derived value for 0
 };
 
 // What densification reads of one frame (host images, all K's size; null where not needed).

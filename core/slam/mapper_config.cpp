@@ -40,6 +40,8 @@ void add_mapper_config_fields(ConfigTable& t, MapperParams& p) {
   t.f("densify.reflection_weight", p.densify.reflection_weight, "δ_w,r: reflection weight below which to densify");
   t.f("densify.sample_ratio", p.densify.sample_ratio, "fraction of candidate pixels that get Gaussians");
   t.i("densify.reflection_samples", p.densify.reflection_samples, "Gaussians per reflection sample along the ray");
+  t.f("densify.reflection_sample_opacity", p.densify.reflection_sample_opacity,
+      "opacity of each Gaussian along a reflection ray (0: the S together as opaque as one new Gaussian)");
   t.f("densify.reflection_near", p.densify.reflection_near, "first sample past the plane, metres");
   t.f("densify.reflection_far", p.densify.reflection_far, "last sample past the plane, metres");
   t.f("densify.max_init_scale", p.densify.max_init_scale, "cap of the initial scale, metres");

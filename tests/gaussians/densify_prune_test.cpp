@@ -157,6 +157,36 @@ TEST(Densify, ReflectionSamplesLiePastThePlaneAlongTheRay) {
   EXPECT_NEAR(r.sh[0].z() * kC0 + 0.5f, 0.0f, 1e-6f);
 }
 
+// The opacity of the samples along a reflection ray: given, or derived so that the S samples
+// together are as opaque as one new Gaussian (1 − (1 − 0.5)^(1/10) = 0.0670 for S = 10).
+TEST(Densify, ReflectionSampleOpacityGivenOrDerived) {
+  WallView w;
+  for (auto& c : w.C.pixels()) c = Color::Zero();
+  const std::vector<ReflectivePlane> planes = {{4, Eigen::Vector4f(0, 0, -2, 4)}};
+  const auto opacity = [](float logit) { return 1.0f / (1.0f + std::exp(-logit)); };
+  DensifyParams p;
+  p.sample_ratio = 1.0f;
+  for (const float given : {0.5f, 0.2f}) {
+    p.reflection_sample_opacity = given;
+    const GaussianHost g = densify_reflection(w.view(), planes, p, 0, 3);
+    ASSERT_GT(g.size(), 0u);
+    for (float l : g.logit_opacities) ASSERT_NEAR(opacity(l), given, 1e-6f);
+  }
+  p.reflection_sample_opacity = 0.0f;
+  EXPECT_NEAR(p.reflection_sample_alpha(), 0.066967f, 1e-5f);
+  const GaussianHost g = densify_reflection(w.view(), planes, p, 0, 3);
+  ASSERT_GT(g.size(), 0u);
+  float transmitted = 1.0f;  // through the ten samples of one ray
+  for (int j = 0; j < 10; ++j) transmitted *= 1.0f - opacity(g.logit_opacities[size_t(j)]);
+  EXPECT_NEAR(1.0f - transmitted, p.init_opacity, 1e-5f);
+  p.reflection_samples = 4;
+  EXPECT_NEAR(1.0f - std::pow(1.0f - p.reflection_sample_alpha(), 4.0f), p.init_opacity, 1e-6f);
+  for (const float bad : {-0.1f, 1.0f}) {
+    p.reflection_sample_opacity = bad;
+    EXPECT_THROW(p.validate(), std::invalid_argument) << bad;
+  }
+}
+
 TEST(Densify, RejectsMissingOrMisSizedImages) {
   WallView w;
   DensifyView v = w.view();
