@@ -6,9 +6,9 @@
 
 #include <gtest/gtest.h>
 
-#include <chrono>
-#include <future>
-#include <thread>
+#include <fstream>
+#include <iterator>
+#include <string>
 
 namespace rrg::test {
 namespace {
@@ -31,13 +31,17 @@ TEST(StreamRetry, AFullServerFailsWithoutRetriesAndIsRetriedUntilASlotFrees) {
   EXPECT_NE(still.exit_code, 0);
   EXPECT_NE(still.output.find("still full after 1 retries"), std::string::npos) << still.output;
 
-  // The held session closes while the stream waits between retries: the stream gets the slot.
-  auto streamed = std::async(std::launch::async, [&] { return run_rrg(stream_args(s, 20)); });
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  // The held session closes while the stream waits between retries: the stream gets the slot. It
+  // is closed once the stream has logged its first refusal, not after a fixed pause (on a loaded
+  // machine the process may take longer than any pause to start, and would then find the slot free).
+  TempDir dir("stream_retry");
+  BackgroundRrg streamed(stream_args(s, 20), dir / "log.txt");
+  ASSERT_TRUE(streamed.wait_for_output("is full")) << "the stream never found the server full";
   c.close({held.session_id(), held.token()});
-  const CommandResult ok = streamed.get();
-  EXPECT_EQ(ok.exit_code, 0) << ok.output;
-  EXPECT_NE(ok.output.find("is full"), std::string::npos) << ok.output;  // it did wait for the slot
+  EXPECT_EQ(streamed.wait(), 0);
+  std::ifstream log(dir / "log.txt");
+  const std::string out((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+  EXPECT_NE(out.find("frames sent"), std::string::npos) << out;  // it streamed once the slot was free
 }
 
 }  // namespace
