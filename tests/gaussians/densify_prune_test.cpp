@@ -173,6 +173,7 @@ TEST(Densify, ReflectionSampleOpacityGivenOrDerived) {
     for (float l : g.logit_opacities) ASSERT_NEAR(opacity(l), given, 1e-6f);
   }
   p.reflection_sample_opacity = 0.0f;
+  EXPECT_EQ(DensifyParams{}.reflection_sample_opacity, 0.0f);  // derived is the default
   EXPECT_NEAR(p.reflection_sample_alpha(), 0.066967f, 1e-5f);
   const GaussianHost g = densify_reflection(w.view(), planes, p, 0, 3);
   ASSERT_GT(g.size(), 0u);
