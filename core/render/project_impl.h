@@ -86,7 +86,7 @@ void project_bwd(Backend b, View view, GaussianViews g, Span<const SplatGrad> v_
     Vec3<float> v_mean = Vec3<float>::Zero(), v_log_scale = Vec3<float>::Zero();
     Vec4<float> v_quat = Vec4<float>::Zero();
     float v_logit = 0;
-    // A splat no pixel sent gradient to (most of the map lies outside any one view) has zero
+    // A splat no pixel sent gradient to (the part of the map outside the view) has zero
     // parameter gradients: written as such without redoing its projection.
     const bool any = !is_zero(v_splats[i]);
     if (any) {
