@@ -72,10 +72,12 @@ int64_t adam_step(Backend be, int64_t n, AdamArgs a, AdamTensors t) {
           adam_update(t.quats[i][c], t.v_quats[i][c], m[j], v[j], a.lr_rotation, a, bc1, bc2);
         adam_update(t.logit_opacities[i], t.v_logit_opacities[i], m[j], v[j], a.lr_opacity, a, bc1, bc2);
         ++j;
-        for (int k = 0; k < K; ++k)
-          for (int c = 0; c < 3; ++c, ++j)
-            adam_update(t.sh[i * K + k][c], t.v_sh[i * K + k][c], m[j], v[j], k == 0 ? a.lr_sh0 : a.lr_sh_rest, a,
-                        bc1, bc2);
+        // The SH coefficients as one run of 3K floats (Vector3f has no padding): the DC band's three
+        // with lr_sh0, then the rest with lr_sh_rest, a plain loop the host compiler vectorises.
+        float* sh = t.sh[i * K].data();
+        const float* v_sh = t.v_sh[i * K].data();
+        for (int q = 0; q < 3; ++q) adam_update(sh[q], v_sh[q], m[j + q], v[j + q], a.lr_sh0, a, bc1, bc2);
+        for (int q = 3; q < 3 * K; ++q) adam_update(sh[q], v_sh[q], m[j + q], v[j + q], a.lr_sh_rest, a, bc1, bc2);
         return 1;
       },
       [] RRG_HD(int64_t x, int64_t y) { return x + y; });

@@ -90,8 +90,13 @@ TEST(Adam, KnownAnswerVisibilityAndParity) {
   EXPECT_NEAR(got[3], ref(-4.0, 1.0, lr.log_scale), 1e-6);
   EXPECT_NEAR(got[6], ref(1.0, 0.1, lr.rotation), 1e-7);
   EXPECT_NEAR(got[10], ref(0.0, -0.25, lr.opacity), 1e-6);
+  // SH: the DC band's three channels with lr_sh0, every later coefficient with lr_sh_rest (the
+  // first and the last of each run, where a wrong boundary of the two rates would show).
   EXPECT_NEAR(got[11], ref(0.0, 0.01, lr.sh0), 1e-7);
+  EXPECT_EQ(got[12], 0.0);
+  EXPECT_NEAR(got[13], ref(0.0, 0.02, lr.sh0), 1e-7);
   EXPECT_NEAR(got[14], ref(0.0, 0.02, lr.sh_rest), 1e-7);
+  EXPECT_NEAR(got[22], ref(0.0, 0.08, lr.sh_rest), 1e-7);
   // Gaussian 1 had no gradient: untouched.
   const size_t per = 11 + 3 * K;
   EXPECT_EQ(got[per + 0], 1.0);
