@@ -8,6 +8,15 @@
 #define RRG_HD
 #endif
 
+// RRG_TU_LOCAL: internal linkage (static) for a shared per-element function the host compiler may
+// keep out of line (the ray march, the projection). An inline function with external linkage is one
+// entity in the whole program: the g++ copy from a .cpp and nvcc's host copy from a .cu are both
+// weak symbols, and the linker keeps one. The CPU back end then ran nvcc's host build of e.g.
+// projection_terms, and its results depended on whether the CUDA back end was compiled in
+// (2026-12-02). With static, each object file calls its own copy. The test `shared_symbols`
+// (cmake/check_shared_symbols.cmake) fails when a .cu and a .cpp object define the same rrg symbol.
+#define RRG_TU_LOCAL static
+
 // RRG_INLINE: always inline a small per-sample helper into its (hot) caller. The host compiler's
 // heuristics otherwise keep e.g. the trilinear sample of the ray march an out-of-line call whose
 // results go through memory.

@@ -66,7 +66,7 @@ struct ProjectionT {
 
 // Fills pr; false when the Gaussian is culled (behind the near plane, or degenerate Sigma').
 template <class T, class S>
-RRG_HD inline bool projection_terms(const ViewT<T>& v, const GaussianInT<T, S>& g, ProjectionT<T>& pr) {
+RRG_TU_LOCAL RRG_HD inline bool projection_terms(const ViewT<T>& v, const GaussianInT<T, S>& g, ProjectionT<T>& pr) {
   const Mat3<T> W = v.R();
   pr.p_c = W * g.mean + v.t();
   const T z = pr.p_c.z();
@@ -133,7 +133,7 @@ RRG_HD inline TileRect tile_rect(const ViewT<T>& v, const SplatT<T>& s, T radius
 // Gradients of one Gaussian's parameters from the gradient of its splat (v_sh accumulates, the rest
 // is written). Recomputes the forward terms; a culled Gaussian gets zeros.
 template <class T, class S>
-RRG_HD inline void project_gaussian_bwd(const ViewT<T>& v, const GaussianInT<T, S>& g, const SplatT<T>& vs,
+RRG_TU_LOCAL RRG_HD inline void project_gaussian_bwd(const ViewT<T>& v, const GaussianInT<T, S>& g, const SplatT<T>& vs,
                                         Vec3<T>& v_mean, Vec3<T>& v_log_scale, Vec4<T>& v_quat,
                                         T& v_logit_opacity, Vec3<T>* v_sh) {
   v_mean.setZero();

@@ -76,7 +76,7 @@ RRG_HD inline Vec3<T> sh_color(int degree, const S* sh, const Vec3<T>& mean, con
 // Backward of sh_color: v_sh[k] += b_k * v_raw (channels clamped at 0 pass no gradient); returns
 // the gradient w.r.t. the mean through the view direction.
 template <class T, class S>
-RRG_HD inline Vec3<T> sh_color_bwd(int degree, const S* sh, const Vec3<T>& mean, const Vec3<T>& center,
+RRG_TU_LOCAL RRG_HD inline Vec3<T> sh_color_bwd(int degree, const S* sh, const Vec3<T>& mean, const Vec3<T>& center,
                                    const Vec3<T>& v_color, Vec3<T>* v_sh) {
   const Vec3<T> v = mean - center;
   const T len = v.norm();

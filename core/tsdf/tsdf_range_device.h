@@ -63,7 +63,7 @@ RRG_HD inline void range_at(const RangeImage& r, int x, int y, float& near, floa
 }
 
 // Projects block `key` (camera R_cw, t_cw) into the tiles it may cover.
-RRG_HD inline void range_splat_block(const RangeImage& r, uint64_t key, float voxel_size, const Intrinsics& K,
+RRG_TU_LOCAL RRG_HD inline void range_splat_block(const RangeImage& r, uint64_t key, float voxel_size, const Intrinsics& K,
                                      const Eigen::Matrix3f& R_cw, const Eigen::Vector3f& t_cw, float min_depth,
                                      float max_depth) {
   const Eigen::Vector3f lo = (block_coord(key) * int(kBlockSide)).cast<float>() * voxel_size;

@@ -45,7 +45,7 @@ RRG_HD inline float block_exit(const Eigen::Vector3f& p, const Eigen::Vector3f& 
 //                                                into the band behind it (f ≥ −1), where the crossing
 //                                                is still bracketed (as Open3D's march steps);
 //   f ≤ 0 without a positive sample before    → one voxel (entering from behind a surface).
-RRG_HD inline RayHit march(const VolumeView& vol, const Eigen::Vector3f& o, const Eigen::Vector3f& d,
+RRG_TU_LOCAL RRG_HD inline RayHit march(const VolumeView& vol, const Eigen::Vector3f& o, const Eigen::Vector3f& d,
                            float truncation, float z_start, float z_end, BlockCache& cache) {
   RayHit hit;
   const float len = d.norm();           // metres per unit of z
@@ -144,7 +144,7 @@ struct Neighbourhood {
 // Normal and attributes at a surface point p (trilinear, as the supplement's C_var); the colour
 // and the reflection attributes (π, R_raw, C_var) only when asked for (left 0 otherwise). `cache`
 // may hold blocks from the march.
-RRG_HD inline SurfaceSample shade(const VolumeView& vol, const Eigen::Vector3f& p, Span<const int32_t> remap,
+RRG_TU_LOCAL RRG_HD inline SurfaceSample shade(const VolumeView& vol, const Eigen::Vector3f& p, Span<const int32_t> remap,
                                   BlockCache& cache, bool want_color, bool want_reflection) {
   constexpr float kEps = 1e-6f;
   SurfaceSample out;
