@@ -48,6 +48,26 @@ T depth_l1_loss(Backend be, Span<const T> d, Span<const T> d_gt, Span<T> v_d, T 
   return sc.sum / sc.count;
 }
 
+// s[ch][m] = Σ_k g(k) src[(q_k · 3 + ch) · M + m] over the SSIM window around pixel p along one axis
+// (q_k = p + k, or p + k · w when vertical), clipped at the image border (zero padding): one
+// separable pass over M stored moments per channel, taps in ascending k.
+template <int M, class T>
+RRG_HD inline void ssim_window_sum(const T* src, int64_t p, int w, int h, bool vertical, const SsimWindow<T>& win,
+                                   T (&s)[3][M]) {
+  constexpr int R = kSsimRadius;
+  const int pos = vertical ? int(p / w) : int(p % w), len = vertical ? h : w;
+  const int k0 = pos - R < 0 ? -pos : -R, k1 = pos + R >= len ? len - 1 - pos : R;
+  const int64_t step = vertical ? w : 1;
+  for (int ch = 0; ch < 3; ++ch)
+    for (int m = 0; m < M; ++m) s[ch][m] = T(0);
+  for (int k = k0; k <= k1; ++k) {
+    const int64_t j = (p + k * step) * 3;
+    const T g = win.g[k + R];
+    for (int ch = 0; ch < 3; ++ch)
+      for (int m = 0; m < M; ++m) s[ch][m] += g * src[(j + ch) * M + m];
+  }
+}
+
 // SSIM = mean over pixels and channels of the SSIM map (3DGS: 11×11 Gaussian window, σ = 1.5, zero
 // padding). Separable windowed sums; scratch holds 36 · W · H scalars. The gradient uses
 // ∂SSIM_mean/∂x_q = 1/(3N) Σ_p g(p−q) [a(p) + 2 x_q b(p) + y_q c(p)]
@@ -80,15 +100,8 @@ T ssim(Backend be, int w, int h, Span<const T> x, Span<const T> y, Span<T> v_x, 
       for (int m = 0; m < 5; ++m) hm[(p * 3 + ch) * 5 + m] = s[ch][m];
   });
   parallel_for(be, n, [=] RRG_HD(int64_t p) {
-    const int px = int(p % w), py = int(p / w);
-    const int k0 = py - R < 0 ? -py : -R, k1 = py + R >= h ? h - 1 - py : R;
-    T s[3][5] = {};
-    for (int k = k0; k <= k1; ++k) {
-      const int64_t j = (int64_t(py + k) * w + px) * 3;
-      const T g = win.g[k + R];
-      for (int ch = 0; ch < 3; ++ch)
-        for (int m = 0; m < 5; ++m) s[ch][m] += g * hm[(j + ch) * 5 + m];
-    }
+    T s[3][5];
+    ssim_window_sum<5>(hm, p, w, h, true, win, s);
     for (int ch = 0; ch < 3; ++ch) {
       const int64_t i = p * 3 + ch;
       T a, b, c;
@@ -100,29 +113,15 @@ T ssim(Backend be, int w, int h, Span<const T> x, Span<const T> y, Span<T> v_x, 
       be, n * 3, T(0), [=] RRG_HD(int64_t i) { return smap[i]; }, [] RRG_HD(T a, T b) { return a + b; });
   if (!v_x.empty()) {
     parallel_for(be, n, [=] RRG_HD(int64_t p) {
-      const int px = int(p % w), py = int(p / w);
-      const int k0 = px - R < 0 ? -px : -R, k1 = px + R >= w ? w - 1 - px : R;
-      T s[3][3] = {};
-      for (int k = k0; k <= k1; ++k) {
-        const int64_t j = (int64_t(py) * w + px + k) * 3;
-        const T g = win.g[k + R];
-        for (int ch = 0; ch < 3; ++ch)
-          for (int m = 0; m < 3; ++m) s[ch][m] += g * abc[(j + ch) * 3 + m];
-      }
+      T s[3][3];
+      ssim_window_sum<3>(abc, p, w, h, false, win, s);
       for (int ch = 0; ch < 3; ++ch)
         for (int m = 0; m < 3; ++m) hs[(p * 3 + ch) * 3 + m] = s[ch][m];
     });
     const T scale = weight / T(n * 3);
     parallel_for(be, n, [=] RRG_HD(int64_t p) {
-      const int px = int(p % w), py = int(p / w);
-      const int k0 = py - R < 0 ? -py : -R, k1 = py + R >= h ? h - 1 - py : R;
-      T s[3][3] = {};
-      for (int k = k0; k <= k1; ++k) {
-        const int64_t j = (int64_t(py + k) * w + px) * 3;
-        const T g = win.g[k + R];
-        for (int ch = 0; ch < 3; ++ch)
-          for (int m = 0; m < 3; ++m) s[ch][m] += g * hs[(j + ch) * 3 + m];
-      }
+      T s[3][3];
+      ssim_window_sum<3>(hs, p, w, h, true, win, s);
       for (int ch = 0; ch < 3; ++ch) {
         const int64_t i = p * 3 + ch;
         v_x[i] += scale * (s[ch][0] + T(2) * x[i] * s[ch][1] + y[i] * s[ch][2]);
