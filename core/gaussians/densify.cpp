@@ -117,14 +117,17 @@ float DensifyParams::reflection_sample_alpha() const {
 
 GaussianHost init_gaussians(std::span<const Eigen::Vector3f> points, std::span<const Eigen::Vector3f> normals,
                             std::span<const Color> colors, std::span<const int32_t> plane_ids,
-                            const DensifyParams& params, float min_init_scale, float max_init_scale, int sh_degree) {
+                            std::span<const float> opacities, const DensifyParams& params, float min_init_scale,
+                            float max_init_scale, int sh_degree) {
   const size_t n = points.size();
-  if (normals.size() != n || colors.size() != n || plane_ids.size() != n)
-    throw std::invalid_argument("init_gaussians: points, normals, colours and plane ids differ in length");
+  if (normals.size() != n || colors.size() != n || plane_ids.size() != n || opacities.size() != n)
+    throw std::invalid_argument("init_gaussians: points, normals, colours, plane ids and opacities differ in length");
+  for (const float o : opacities)
+    if (!(o > 0.0f && o < 1.0f))
+      throw std::invalid_argument("init_gaussians: opacity " + std::to_string(o) + " is outside (0, 1)");
   GaussianHost h(sh_degree);
   h.resize(n);
   const std::vector<float> s = knn3_scale(points, max_init_scale);
-  const float logit = std::log(params.init_opacity / (1.0f - params.init_opacity));
   const int K = h.sh_coeffs();
   for (size_t i = 0; i < n; ++i) {
     const float si = std::clamp(s[i], min_init_scale, max_init_scale);
@@ -132,7 +135,7 @@ GaussianHost init_gaussians(std::span<const Eigen::Vector3f> points, std::span<c
     h.log_scales[i] = Eigen::Vector3f(std::log(si), std::log(si), std::log(si * params.flatten));
     const Eigen::Quaternionf q = Eigen::Quaternionf::FromTwoVectors(Eigen::Vector3f::UnitZ(), normals[i]);
     h.quats[i] = Eigen::Vector4f(q.w(), q.x(), q.y(), q.z());
-    h.logit_opacities[i] = logit;
+    h.logit_opacities[i] = std::log(opacities[i] / (1.0f - opacities[i]));
     h.sh[i * size_t(K)] = (colors[i] - Color::Constant(0.5f)) / kShC0;
     h.plane_ids[i] = plane_ids[i];
   }
@@ -171,7 +174,8 @@ GaussianHost densify_base(const DensifyView& v, const DensifyParams& p, int sh_d
       col.push_back((*v.C_gt)(x, y));
     }
   const std::vector<int32_t> ids(pts.size(), 0);
-  return init_gaussians(pts, nrm, col, ids, p, p.base_min_init_scale, p.max_init_scale, sh_degree);
+  const std::vector<float> opacities(pts.size(), p.init_opacity);
+  return init_gaussians(pts, nrm, col, ids, opacities, p, p.base_min_init_scale, p.max_init_scale, sh_degree);
 }
 
 GaussianHost densify_reflection(const DensifyView& v, std::span<const ReflectivePlane> planes, const DensifyParams& p,
@@ -193,7 +197,10 @@ GaussianHost densify_reflection(const DensifyView& v, std::span<const Reflective
   std::vector<Eigen::Vector3f> pts, nrm;
   std::vector<Color> col;
   std::vector<int32_t> ids;
-  std::vector<uint8_t> on_ray;  // 1: one of the S samples along a ray; 0: at the mirrored surface
+  // One of the S samples along a ray: the sample opacity (together as opaque as one new Gaussian);
+  // a Gaussian at the mirrored surface: the base's initial opacity.
+  std::vector<float> opacities;
+  const float sample_alpha = p.reflection_sample_alpha();
   const Eigen::Vector3f o = v.T_wc.translation();
   const Eigen::Matrix3f R_wc = v.T_wc.linear();
   const int S = p.reflection_samples;
@@ -237,7 +244,7 @@ GaussianHost densify_reflection(const DensifyView& v, std::span<const Reflective
           nrm.push_back(n);
           col.push_back(c);
           ids.push_back(id);
-          on_ray.push_back(0);
+          opacities.push_back(p.init_opacity);
           ++at_mirrored;
           continue;
         }
@@ -249,19 +256,15 @@ GaussianHost densify_reflection(const DensifyView& v, std::span<const Reflective
         nrm.push_back(n);
         col.push_back(c);
         ids.push_back(id);
-        on_ray.push_back(1);
+        opacities.push_back(sample_alpha);
       }
     }
   spdlog::debug("densify_reflection: {} reflective plane(s); pixels on them {}, with R = 1 {}, error > {} {}, "
                 "C_var > {} {}, W_r < {} {}, sampled {} ({} at the mirrored surface)",
                 planes.size(), on_plane, masked, p.reflection_error, wrong, p.variance, varying, p.reflection_weight,
                 uncovered, sampled, at_mirrored);
-  GaussianHost h = init_gaussians(pts, nrm, col, ids, p, p.reflection_min_init_scale, p.reflection_max_init_scale, sh_degree);
-  const float alpha = p.reflection_sample_alpha();
-  const float logit = std::log(alpha / (1.0f - alpha));
-  for (size_t i = 0; i < h.size(); ++i)
-    if (on_ray[i]) h.logit_opacities[i] = logit;
-  return h;
+  return init_gaussians(pts, nrm, col, ids, opacities, p, p.reflection_min_init_scale, p.reflection_max_init_scale,
+                        sh_degree);
 }
 
 }  // namespace rrg

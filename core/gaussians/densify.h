@@ -100,9 +100,11 @@ GaussianHost densify_base(const DensifyView& view, const DensifyParams& params, 
 GaussianHost densify_reflection(const DensifyView& view, std::span<const ReflectivePlane> planes,
                                 const DensifyParams& params, int sh_degree, uint64_t seed);
 
-// The shared initialisation: points (world), unit normals along which to flatten, colours, plane ids.
+// The shared initialisation: points (world), unit normals along which to flatten, colours, plane ids
+// and opacities in (0, 1), one per point.
 GaussianHost init_gaussians(std::span<const Eigen::Vector3f> points, std::span<const Eigen::Vector3f> normals,
                             std::span<const Color> colors, std::span<const int32_t> plane_ids,
-                            const DensifyParams& params, float min_init_scale, float max_init_scale, int sh_degree);
+                            std::span<const float> opacities, const DensifyParams& params, float min_init_scale,
+                            float max_init_scale, int sh_degree);
 
 }  // namespace rrg

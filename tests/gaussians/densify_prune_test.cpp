@@ -188,6 +188,48 @@ TEST(Densify, ReflectionSampleOpacityGivenOrDerived) {
   }
 }
 
+// With the mirrored-surface option a pixel whose virtual view meets geometry behind the plane gets
+// one Gaussian there, with a new Gaussian's opacity; the other pixels keep the S ray samples with
+// the sample opacity. init_gaussians takes one opacity per point and rejects one outside (0, 1).
+TEST(Densify, MirroredSurfaceGaussiansTakeTheInitialOpacity) {
+  WallView w;
+  for (auto& c : w.C.pixels()) c = Color::Zero();
+  const std::vector<ReflectivePlane> planes = {{4, Eigen::Vector4f(0, 0, -2, 4)}};  // z = 2
+  Image<float> virtual_depth(32, 24, 0.0f);
+  for (int y = 0; y < 24; ++y)
+    for (int x = 0; x < 16; ++x) virtual_depth(x, y) = 3.0f;  // left half: a surface 1 m behind the plane
+  DensifyParams p;
+  p.sample_ratio = 1.0f;
+  p.reflection_mirrored_depth = true;
+  DensifyView v = w.view();
+  v.virtual_depth = &virtual_depth;
+  const GaussianHost g = densify_reflection(v, planes, p, 0, 3);
+  ASSERT_EQ(g.size(), size_t(16 * 24 * 1 + 16 * 24 * 10));
+  const auto opacity = [](float logit) { return 1.0f / (1.0f + std::exp(-logit)); };
+  size_t at_surface = 0, on_rays = 0;
+  for (size_t i = 0; i < g.size(); ++i) {
+    if (std::abs(g.means[i].z() - 3.0f) < 1e-4f) {
+      EXPECT_NEAR(opacity(g.logit_opacities[i]), p.init_opacity, 1e-6f);
+      ++at_surface;
+    } else {
+      EXPECT_NEAR(opacity(g.logit_opacities[i]), p.reflection_sample_alpha(), 1e-6f);
+      ++on_rays;
+    }
+  }
+  EXPECT_EQ(at_surface, size_t(16 * 24));
+  EXPECT_EQ(on_rays, size_t(16 * 24 * 10));
+
+  const std::vector<Eigen::Vector3f> pts = {Eigen::Vector3f(0, 0, 1)}, nrm = {Eigen::Vector3f::UnitZ()};
+  const std::vector<Color> col = {Color::Zero()};
+  const std::vector<int32_t> ids = {0};
+  for (const float bad : {0.0f, 1.0f, -0.5f, NAN})
+    EXPECT_THROW(init_gaussians(pts, nrm, col, ids, std::vector<float>{bad}, p, 0.001f, 0.01f, 0), std::invalid_argument)
+        << bad;
+  EXPECT_THROW(init_gaussians(pts, nrm, col, ids, std::vector<float>{}, p, 0.001f, 0.01f, 0), std::invalid_argument);
+  EXPECT_NEAR(opacity(init_gaussians(pts, nrm, col, ids, std::vector<float>{0.3f}, p, 0.001f, 0.01f, 0).logit_opacities[0]),
+              0.3f, 1e-6f);
+}
+
 TEST(Densify, RejectsMissingOrMisSizedImages) {
   WallView w;
   DensifyView v = w.view();
