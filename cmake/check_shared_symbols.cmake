@@ -17,9 +17,10 @@ function(weak_rrg_symbols out_var)
     endif()
     string(REPLACE "\n" ";" _lines "${_out}")
     foreach(_line IN LISTS _lines)
-      # "<address> W <mangled name>": weak definitions of functions in namespace rrg (_ZN3rrg...,
-      # _ZNK3rrg... for const members, and templates whose mangled name starts with a return type).
-      if(_line MATCHES "^[0-9a-f]+ [WV] (_Z.*N3rrg.*)$")
+      # "<address> W <mangled name>": weak definitions of functions and members in namespace rrg
+      # (_ZN3rrg..., _ZNK3rrg... for const members). Library templates merely instantiated with rrg
+      # types (std::vector<rrg::...>) are not ours to keep apart and are not matched.
+      if(_line MATCHES "^[0-9a-f]+ [WV] (_ZNK?3rrg.*)$")
         list(APPEND _all "${CMAKE_MATCH_1}")
       endif()
     endforeach()
