@@ -50,7 +50,10 @@ MappingScene make_scene(int width, int height, const Device& device) {
 void BM_MappingStep(benchmark::State& state, int width, int height, Device device) {
   const MappingScene s = make_scene(width, height, device);
   MappingContext ctx;
-  ctx.raycast = [&s](const Intrinsics& K, const Eigen::Isometry3f& T) { return raycast(*s.volume, K, T); };
+  // What the session's mapping context asks for: no V*, N* (core/slam/session.cpp).
+  ctx.raycast = [&s](const Intrinsics& K, const Eigen::Isometry3f& T) {
+    return raycast(*s.volume, K, T, {}, RaycastOutputs{.color = true, .reflection = true, .normals = false});
+  };
   GaussianMapper mapper(MapperParams{}, s.K, device);
   int64_t next = 0;
   auto feed = [&] {

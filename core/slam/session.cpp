@@ -140,13 +140,16 @@ RaycastResult Session::Impl::locked_raycast(const Intrinsics& K_, const Eigen::I
 ColorImage Session::Impl::render_reflection(const Eigen::Isometry3f& T_wc) {
   const auto snap = mapper.snapshot();
   if (!snap || snap->reflection.size() == 0) return ColorImage(K.width, K.height, Color::Zero());
-  const RaycastResult rc = locked_raycast(K, T_wc, RaycastOutputs{.color = false, .reflection = true});
+  const RaycastResult rc = locked_raycast(K, T_wc, RaycastOutputs{.color = false, .reflection = true, .normals = false});
   return mapper.render_reflection(RenderCamera{K, T_wc}, rc.plane_ids);
 }
 
 MappingContext Session::Impl::mapping_context() {
   MappingContext ctx;
-  ctx.raycast = [this](const Intrinsics& K_, const Eigen::Isometry3f& T_wc) { return locked_raycast(K_, T_wc); };
+  // The mapper reads D_t, C_t, I, R and C_var (to_inputs, densify), never V* or N*.
+  ctx.raycast = [this](const Intrinsics& K_, const Eigen::Isometry3f& T_wc) {
+    return locked_raycast(K_, T_wc, RaycastOutputs{.color = true, .reflection = true, .normals = false});
+  };
   if (config.mapping.reflections) {
     std::lock_guard lock(state_mutex);
     for (const ReflectivePlane& p : reflective) ctx.planes.push_back({p.id, p.plane});
@@ -159,7 +162,7 @@ void Session::Impl::identify(const SessionFrame& frame, const Eigen::Isometry3f&
                              DeviceImage<int32_t>& plane_ids, DeviceImage<uint8_t>& mask) {
   const auto t0 = Clock::now();
   // C_var only: the identification reads no colour from the map (its colour edges are the input's).
-  const RaycastResult rc = locked_raycast(K, T_wc, RaycastOutputs{.color = false, .reflection = true});
+  const RaycastResult rc = locked_raycast(K, T_wc, RaycastOutputs{.color = false, .reflection = true, .normals = false});
   const Image<float> cvar = rc.color_variance.to_host();
   IdentificationFrame f{&frame.depth, &frame.color, frame.labels ? &*frame.labels : nullptr, K, T_wc, frame.index,
                         config.tsdf.voxel_size};

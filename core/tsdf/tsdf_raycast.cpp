@@ -15,8 +15,9 @@ void raycast_into(RaycastResult& r, const TsdfVolume& volume, const Intrinsics& 
   const int wc = outputs.color ? w : 0, hc = outputs.color ? h : 0;
   const int wr = outputs.reflection ? w : 0, hr = outputs.reflection ? h : 0;
   r.depth.ensure(w, h, dev);
-  r.vertices.ensure(w, h, dev);
-  r.normals.ensure(w, h, dev);
+  const int wn = outputs.normals ? w : 0, hn = outputs.normals ? h : 0;
+  r.vertices.ensure(wn, hn, dev);
+  r.normals.ensure(wn, hn, dev);
   r.colors.ensure(wc, hc, dev);
   r.plane_ids.ensure(wr, hr, dev);
   r.reflection.ensure(wr, hr, dev);
@@ -32,7 +33,7 @@ void raycast_into(RaycastResult& r, const TsdfVolume& volume, const Intrinsics& 
                         p.min_depth, p.max_depth, {near.span(), far.span(), tiles_x, tiles_y},
                         remap.span(), r.depth.view(), r.vertices.view(), r.normals.view(), r.colors.view(),
                         r.plane_ids.view(), r.reflection.view(), r.reflection_mask.view(),
-                        r.color_variance.view(), outputs.color, outputs.reflection};
+                        r.color_variance.view(), outputs.color, outputs.reflection, outputs.normals};
   RRG_DISPATCH(dev, kernel::raycast_cpu(a), kernel::raycast_cuda(a));
 }
 

@@ -11,13 +11,16 @@
 
 namespace rrg {
 
-// What a raycast computes besides the geometry (D_t, V*, N*, always). Shading reads a hit's voxel
-// attributes only for the outputs asked for: tracking needs the geometry alone, the renderer all.
+// What a raycast computes besides the depth D_t (always). Shading reads a hit's voxel attributes
+// only for the outputs asked for, and the 24 voxels beyond its cell only for the normal: tracking
+// needs the geometry (D_t, V*, N*) alone; the mapper, the identification and the tracking mask's
+// reflection render need D_t and attributes but no V*, N*.
 struct RaycastOutputs {
   bool color = true;       // C_t
   bool reflection = true;  // I, R_raw, R, C_var
-  static constexpr RaycastOutputs all() { return {true, true}; }
-  static constexpr RaycastOutputs geometry() { return {false, false}; }
+  bool normals = true;     // V*, N* (tracking's ICP model); the normal is the costlier half of shading
+  static constexpr RaycastOutputs all() { return {true, true, true}; }
+  static constexpr RaycastOutputs geometry() { return {false, false, true}; }
 };
 
 // Every image asked for is K's size (the others are empty, 0 x 0); pixels without a surface hold 0.

@@ -141,11 +141,12 @@ struct Neighbourhood {
   }
 };
 
-// Normal and attributes at a surface point p (trilinear, as the supplement's C_var); the colour
-// and the reflection attributes (π, R_raw, C_var) only when asked for (left 0 otherwise). `cache`
-// may hold blocks from the march.
+// Normal and attributes at a surface point p (trilinear, as the supplement's C_var); the normal,
+// the colour and the reflection attributes (π, R_raw, C_var) only when asked for (left 0
+// otherwise; without the normal the 24 voxels beyond the cell are not read). `cache` may hold
+// blocks from the march.
 RRG_TU_LOCAL RRG_HD inline SurfaceSample shade(const VolumeView& vol, const Eigen::Vector3f& p, Span<const int32_t> remap,
-                                  BlockCache& cache, bool want_color, bool want_reflection) {
+                                  BlockCache& cache, bool want_color, bool want_reflection, bool want_normal) {
   constexpr float kEps = 1e-6f;
   SurfaceSample out;
   const Eigen::Vector3f q = p * (1.0f / vol.voxel_size);
@@ -183,17 +184,19 @@ RRG_TU_LOCAL RRG_HD inline SurfaceSample shade(const VolumeView& vol, const Eige
     tc[c] = voxel_codec::decode_tsdf(vol.geometry[corner[c]].tsdf);
   }
   // The corners' attributes (another array than the TSDF the march has been reading, so not in
-  // the caches yet): requested now, read after the 24 neighbours below.
+  // the caches yet): requested now, read after the 24 neighbours below (when the normal is asked for).
   if (want_color || want_reflection)
     for (int c = 0; c < 8; ++c) RRG_PREFETCH(&vol.attributes[corner[c]]);
   bool neighbours = true;  // all 24 outward neighbours observed
-  RRG_UNROLL
-  for (int c = 0; c < 8; ++c) {
-    const int dx = c & 1, dy = (c >> 1) & 1, dz = c >> 2;
-    const int64_t v[3] = {nb.at(3 * dx, 1 + dy, 1 + dz), nb.at(1 + dx, 3 * dy, 1 + dz), nb.at(1 + dx, 1 + dy, 3 * dz)};
-    for (int k = 0; k < 3; ++k) {
-      neighbours = neighbours && v[k] >= 0;
-      tn[k][c] = v[k] >= 0 ? voxel_codec::decode_tsdf(vol.geometry[v[k]].tsdf) : 0.0f;
+  if (want_normal) {
+    RRG_UNROLL
+    for (int c = 0; c < 8; ++c) {
+      const int dx = c & 1, dy = (c >> 1) & 1, dz = c >> 2;
+      const int64_t v[3] = {nb.at(3 * dx, 1 + dy, 1 + dz), nb.at(1 + dx, 3 * dy, 1 + dz), nb.at(1 + dx, 1 + dy, 3 * dz)};
+      for (int k = 0; k < 3; ++k) {
+        neighbours = neighbours && v[k] >= 0;
+        tn[k][c] = v[k] >= 0 ? voxel_codec::decode_tsdf(vol.geometry[v[k]].tsdf) : 0.0f;
+      }
     }
   }
   float w[8];
@@ -216,6 +219,7 @@ RRG_TU_LOCAL RRG_HD inline SurfaceSample shade(const VolumeView& vol, const Eige
     const int nearest = (f.x() >= 0.5f ? 1 : 0) | (f.y() >= 0.5f ? 2 : 0) | (f.z() >= 0.5f ? 4 : 0);
     out.plane = canonical_plane(remap, int32_t(vol.attributes[corner[nearest]].plane));
   }
+  if (!want_normal) return out;
   // Normal: central differences of the trilinear TSDF one voxel apart,
   //   f(p + s e_k) − f(p − s e_k) = Σ_c w_c (d(c + e_k) − d(c − e_k)),
   // when all 24 voxels beyond the cell are observed; within the cell otherwise.

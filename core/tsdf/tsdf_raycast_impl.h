@@ -22,7 +22,7 @@ struct RaycastArgs {
   ImageView<float> reflection;
   ImageView<uint8_t> mask;
   ImageView<float> variance;
-  bool want_color, want_reflection;  // RaycastOutputs: the images above them are empty when false
+  bool want_color, want_reflection, want_normals;  // RaycastOutputs: their images are empty when false
 };
 
 // Pixels per work item of the march: a row of a range tile on the CPU (one thread walks it with one
@@ -74,10 +74,13 @@ void raycast(Backend backend, const RaycastArgs& a) {
         hit = march(args.volume, args.t_wc, d, args.truncation, max_f(near, args.min_depth),
                     min_f(far + 0.01f * args.volume.voxel_size, args.max_depth), cache);
       SurfaceSample s;
-      if (hit.hit) s = shade(args.volume, hit.p_w, args.remap, cache, args.want_color, args.want_reflection);
+      if (hit.hit)
+        s = shade(args.volume, hit.p_w, args.remap, cache, args.want_color, args.want_reflection, args.want_normals);
       args.depth[i] = hit.hit ? hit.z : 0.0f;
-      args.vertices[i] = hit.p_w;
-      args.normals[i] = s.normal;
+      if (args.want_normals) {
+        args.vertices[i] = hit.p_w;
+        args.normals[i] = s.normal;
+      }
       if (args.want_color) args.colors[i] = s.color;
       if (args.want_reflection) {
         args.plane_ids[i] = s.plane;

@@ -125,8 +125,8 @@ TEST(TsdfRaycast, FastMarchAgreesFromFarAndFromInside) {
   }
 }
 
-// RaycastOutputs: leaving out the colour or the reflection maps changes nothing in the maps that are
-// computed, and the maps left out are empty.
+// RaycastOutputs: leaving out the colour, the reflection maps or V*, N* changes nothing in the maps
+// that are computed, and the maps left out are empty.
 void expect_outputs_independent(const Device& device) {
   const test::Scene scene = test::sphere_scene({0, 0, 0}, 0.3f);
   TsdfVolume volume(params_1cm(), device);
@@ -136,6 +136,7 @@ void expect_outputs_independent(const Device& device) {
   const RaycastResult geometry = raycast(volume, kSmallK, T, {}, RaycastOutputs::geometry());
   const RaycastResult color = raycast(volume, kSmallK, T, {}, {.color = true, .reflection = false});
   const RaycastResult refl = raycast(volume, kSmallK, T, {}, {.color = false, .reflection = true});
+  const RaycastResult flat = raycast(volume, kSmallK, T, {}, {.color = true, .reflection = true, .normals = false});
   const auto same = [](const auto& a, const auto& b) {
     const auto ha = a.to_host(), hb = b.to_host();
     return ha.same_size(hb) && std::equal(ha.data(), ha.data() + ha.size(), hb.data());
@@ -152,6 +153,16 @@ void expect_outputs_independent(const Device& device) {
   EXPECT_TRUE(same(refl.plane_ids, all.plane_ids));
   EXPECT_TRUE(same(refl.reflection, all.reflection));
   EXPECT_TRUE(same(refl.reflection_mask, all.reflection_mask));
+  // Without V*, N*: every other map as with them; those two empty.
+  EXPECT_TRUE(same(flat.depth, all.depth));
+  EXPECT_TRUE(same(flat.colors, all.colors));
+  EXPECT_TRUE(same(flat.color_variance, all.color_variance));
+  EXPECT_TRUE(same(flat.plane_ids, all.plane_ids));
+  EXPECT_TRUE(same(flat.reflection, all.reflection));
+  EXPECT_TRUE(same(flat.reflection_mask, all.reflection_mask));
+  EXPECT_EQ(flat.vertices.width() * flat.vertices.height(), 0);
+  EXPECT_EQ(flat.normals.width() * flat.normals.height(), 0);
+  EXPECT_EQ(all.normals.width(), kSmallK.width);
   EXPECT_EQ(all.colors.width(), kSmallK.width);
   for (const RaycastResult* r : {&geometry, &refl}) EXPECT_EQ(r->colors.width() * r->colors.height(), 0);
   for (const RaycastResult* r : {&geometry, &color}) {
@@ -171,8 +182,11 @@ void expect_outputs_independent(const Device& device) {
   EXPECT_TRUE(same(reused.normals, geometry.normals));
   EXPECT_EQ(reused.colors.width() * reused.colors.height(), 0);
   EXPECT_EQ(reused.color_variance.width() * reused.color_variance.height(), 0);
+  raycast_into(reused, volume, kSmallK, T, {}, {.color = true, .reflection = true, .normals = false});
+  EXPECT_EQ(reused.normals.width() * reused.normals.height(), 0);
   raycast_into(reused, volume, kSmallK, T);
   EXPECT_TRUE(same(reused.depth, all.depth));
+  EXPECT_TRUE(same(reused.vertices, all.vertices));
   EXPECT_TRUE(same(reused.normals, all.normals));
   EXPECT_TRUE(same(reused.colors, all.colors));
   EXPECT_TRUE(same(reused.color_variance, all.color_variance));
