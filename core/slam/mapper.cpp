@@ -77,7 +77,34 @@ int64_t prune_set(GaussianSet& set, GaussianAdam& adam, const PruneParams& p) {
   return int64_t(before - set.size());
 }
 
+std::vector<int32_t> plane_ids_host(const GaussianSet& set, const Device& device) {
+  const Span<const int32_t> l = set.plane_ids();
+  std::vector<int32_t> ids(size_t(l.size));
+  mem::copy(ids.data(), Device::cpu(), l.data, device, ids.size() * sizeof(int32_t));
+  return ids;
+}
+
 }  // namespace
+
+std::vector<int32_t> distinct_planes(std::span<const int32_t> plane_ids) {
+  std::vector<int32_t> ids(plane_ids.begin(), plane_ids.end());
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  ids.erase(std::remove(ids.begin(), ids.end(), 0), ids.end());
+  return ids;
+}
+
+bool shows_any_plane(const Image<int32_t>& I, std::span<const int32_t> planes) {
+  if (planes.empty()) return false;
+  int32_t last = 0;  // runs of one id are common: test each run once
+  for (size_t i = 0; i < I.size(); ++i) {
+    const int32_t l = I[i];
+    if (l == 0 || l == last) continue;
+    if (std::binary_search(planes.begin(), planes.end(), l)) return true;
+    last = l;
+  }
+  return false;
+}
 
 CompactFrame CompactFrame::from(const MappingFrame& frame) {
   CompactFrame s;
@@ -120,6 +147,7 @@ struct GaussianMapper::StepFrame {
   RaycastInputs rc;
   Image<float> C_var;  // host, for reflection densification
   Image<uint8_t> R;
+  bool shows_reflection = true;  // some pixel's I(u) is the plane of a reflection Gaussian
 };
 
 GaussianMapper::GaussianMapper(const MapperParams& params, const Intrinsics& K, const Device& device)
@@ -128,6 +156,7 @@ GaussianMapper::GaussianMapper(const MapperParams& params, const Intrinsics& K, 
       device_(device),
       base_(params.sh_degree, device),
       refl_(params.sh_degree, device),
+      no_reflection_(params.sh_degree, device),
       adam_base_(params.adam_base, params.sh_degree, device),
       adam_refl_(params.adam_reflection, params.sh_degree, device),
       renderer_(device, params.render),
@@ -271,8 +300,15 @@ MappingStats GaussianMapper::step(const MappingContext& ctx) {
   }
   st.ms_densify = ms_since(t0);
 
-  // 3. optimisation: a seeded shuffle of the selected frames, cycled
+  // 3. optimisation: a seeded shuffle of the selected frames, cycled. With the grouped pass 3, a
+  // frame whose plane-id map shows none of the reflection Gaussians' planes is rendered with an
+  // empty reflection set: C_r = 0, W_r = 0 and zero reflection gradients either way (Adam leaves
+  // Gaussians without gradient as they are), without projecting, binning and walking all of them.
   t0 = Clock::now();
+  if (params_.render.variant != ReflectionVariant::NoPlaneGrouping && refl_.size() > 0) {
+    const std::vector<int32_t> planes = distinct_planes(plane_ids_host(refl_, device_));
+    for (StepFrame& f : frames) f.shows_reflection = shows_any_plane(f.rc.I.to_host(), planes);
+  }
   std::vector<size_t> order(frames.size());
   std::iota(order.begin(), order.end(), size_t(0));
   std::mt19937_64 rng(mix(seed));
@@ -282,14 +318,16 @@ MappingStats GaussianMapper::step(const MappingContext& ctx) {
   double loss_sum = 0;
   for (int it = 0; it < params_.iterations; ++it) {
     StepFrame& f = frames[order[size_t(it) % order.size()]];
-    renderer_.render({K_, f.frame->T_wc}, base_, refl_, f.rc, out);
+    const bool pass3 = refl_.size() > 0 && f.shows_reflection;
+    if (refl_.size() > 0 && !pass3) ++st.reflection_skipped;
+    renderer_.render({K_, f.frame->T_wc}, base_, pass3 ? refl_ : no_reflection_, f.rc, out);
     const bool with_refl = reflections && refl_.size() > 0;
     const LossValues L = mapping_loss(out.C, f.C_gt, out.D_b, f.D_gt, with_refl ? &out.C_r : nullptr, lw, up.v_C,
                                       up.v_D_b, up.v_C_r, ssim_scratch_);
     loss_sum += L.total;
-    renderer_.backward(up, v_base_, v_refl_);
+    renderer_.backward(up, v_base_, pass3 ? v_refl_ : v_no_reflection_);
     adam_base_.step(base_, v_base_);
-    if (refl_.size() > 0) adam_refl_.step(refl_, v_refl_);
+    if (pass3) adam_refl_.step(refl_, v_refl_);
   }
   st.iterations = params_.iterations;
   st.frames = int(frames.size());
@@ -306,15 +344,18 @@ MappingStats GaussianMapper::step(const MappingContext& ctx) {
 
   publish();
   st.ms_total = ms_since(t_start);
-  spdlog::debug("mapping step {}: {} frames, +{} / -{} base ({}), +{} / -{} reflection ({}), loss {:.4f}, {:.1f} ms",
+  spdlog::debug("mapping step {}: {} frames, +{} / -{} base ({}), +{} / -{} reflection ({}; pass 3 skipped in {} of {} "
+                "iterations), loss {:.4f}, {:.1f} ms",
                 steps_, st.frames, st.base_added, st.base_pruned, st.base_size, st.reflection_added,
-                st.reflection_pruned, st.reflection_size, st.loss, st.ms_total);
+                st.reflection_pruned, st.reflection_size, st.reflection_skipped, st.iterations, st.loss, st.ms_total);
   return st;
 }
 
 void GaussianMapper::publish() {
+  const GaussianHost refl = refl_.to_host();
   auto snap = std::make_shared<MapSnapshot>(MapSnapshot{GaussianSet::from_host(base_.to_host(), device_),
-                                                        GaussianSet::from_host(refl_.to_host(), device_), 0});
+                                                        GaussianSet::from_host(refl, device_), 0,
+                                                        distinct_planes(refl.plane_ids)});
   std::lock_guard lock(snapshot_mutex_);
   snap->version = ++version_;
   snapshot_ = std::move(snap);
@@ -334,6 +375,8 @@ void GaussianMapper::render(const RenderCamera& cam, const RaycastResult& raycas
 
 ColorImage GaussianMapper::render_reflection(const RenderCamera& cam, const DeviceImage<int32_t>& I) const {
   const auto snap = snapshot();
+  if (params_.render.variant != ReflectionVariant::NoPlaneGrouping && !shows_any_plane(I.to_host(), snap->reflection_planes))
+    return ColorImage(cam.K.width, cam.K.height, Color::Zero());  // what pass 3 would draw: nothing
   RenderOutputs out;
   std::lock_guard lock(render_mutex_);
   query_renderer_.render_reflection(cam, snap->reflection, I, out);

@@ -34,6 +34,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <span>
 #include <vector>
 
 namespace rrg {
@@ -108,13 +109,23 @@ struct MappingStats {
   int64_t base_added = 0, reflection_added = 0, base_pruned = 0, reflection_pruned = 0;
   int64_t base_size = 0, reflection_size = 0;  // after the step
   double loss = 0;                 // mean total loss over the iterations
+  int reflection_skipped = 0;      // iterations whose view shows no reflection Gaussian's plane (pass 3 skipped)
   double ms_raycast = 0, ms_densify = 0, ms_optimise = 0, ms_prune = 0, ms_total = 0;
 };
 
 struct MapSnapshot {             // immutable once published
   GaussianSet base, reflection;
   uint64_t version = 0;            // number of published steps / loads
+  std::vector<int32_t> reflection_planes;  // the distinct non-zero plane ids l of `reflection`, sorted
 };
+
+// Whether pass 3 in its grouped form (a Gaussian reaches pixel u only when its plane id l equals
+// I(u) != 0) can draw anything over plane-id map I for Gaussians on `planes` (sorted): some pixel's
+// I(u) is one of them. When not, C_r = 0 and W_r = 0 everywhere and no reflection Gaussian gets a
+// gradient, so the pass can be skipped with identical results.
+bool shows_any_plane(const Image<int32_t>& I, std::span<const int32_t> planes);
+// The sorted distinct non-zero plane ids of a set's Gaussians.
+std::vector<int32_t> distinct_planes(std::span<const int32_t> plane_ids);
 
 class GaussianMapper {
  public:
@@ -159,8 +170,9 @@ class GaussianMapper {
   Intrinsics K_;
   Device device_;
   GaussianSet base_, refl_;
+  GaussianSet no_reflection_;    // empty: pass 3 of a view that shows none of refl_'s planes
   GaussianAdam adam_base_, adam_refl_;
-  GaussianGrads v_base_, v_refl_;
+  GaussianGrads v_base_, v_refl_, v_no_reflection_;
   Renderer renderer_;
   Buffer<float> ssim_scratch_;
   uint64_t steps_ = 0;

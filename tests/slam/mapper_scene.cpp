@@ -47,6 +47,11 @@ MapperScene make_mapper_scene(const MapperSceneParams& p) {
     s.poses.push_back(plan.frames[size_t(i * p.stride)].T_wc.cast<float>());
     s.frames.push_back(synth::render_view(spec.scene, s.K, s.poses.back()));
   }
+  for (int i = 0; i < p.away; ++i) {
+    const Eigen::Isometry3f T = s.poses[size_t(i)] * Eigen::AngleAxisf(3.14159265f, Eigen::Vector3f::UnitY());
+    s.poses.push_back(T);
+    s.frames.push_back(synth::render_view(spec.scene, s.K, T));
+  }
   for (int i = 0; i < p.novel; ++i) {
     s.novel_poses.push_back(plan.novel[size_t(i)].T_wc.cast<float>());
     s.novel.push_back(synth::render_view(spec.scene, s.K, s.novel_poses.back()));

@@ -21,6 +21,7 @@ struct MapperSceneParams {
   int novel = 0;              // held-out views
   float voxel = 0.02f;        // TSDF voxel size, metres
   bool mirror_only = true;    // reflective planes = the mirror category only (else every F0 > 0 plane)
+  int away = 0;               // further training frames: the first `away` poses turned 180° about the camera's y axis
 };
 
 struct MapperScene {

@@ -263,5 +263,80 @@ TEST(Mapper, ReflectionsImproveTheMirrorOnNovelViews) {
   EXPECT_GE(psnr_with - psnr_without, 1.0);
 }
 
+TEST(Mapper, ShowsAnyPlaneAndDistinctPlanes) {
+  EXPECT_EQ(distinct_planes(std::vector<int32_t>{7, 0, 3, 7, 3, 0, 12}), (std::vector<int32_t>{3, 7, 12}));
+  EXPECT_TRUE(distinct_planes(std::vector<int32_t>{0, 0}).empty());
+  Image<int32_t> I(4, 2, 0);
+  const std::vector<int32_t> planes{3, 7, 12};
+  EXPECT_FALSE(shows_any_plane(I, planes));  // I = 0: no plane, pass 3 draws nothing
+  I[5] = 5;
+  I[6] = 5;
+  EXPECT_FALSE(shows_any_plane(I, planes));  // a plane without reflection Gaussians
+  I[7] = 12;
+  EXPECT_TRUE(shows_any_plane(I, planes));
+  EXPECT_FALSE(shows_any_plane(I, {}));
+}
+
+// The tracking mask's C_r skips pass 3 when the plane-id map shows none of the reflection
+// Gaussians' planes: it must equal the full pass 3 (all zero then) and, where the mirror is in view,
+// be the full pass 3 itself. The mapping step skips pass 3 of such views (MappingStats counts them:
+// the step over the frames turned away from the mirror skips some of its iterations, not all, since
+// its keyframes face the mirror); that the skip leaves the map bit for bit as it was is checked on
+// whole runs (docs/mapping.md).
+TEST(Mapper, ReflectionPassIsSkippedOnlyWhereItDrawsNothing) {
+  test::MapperSceneParams sp;
+  sp.preset = "mirror_room";
+  sp.width = 64;
+  sp.height = 48;
+  sp.frames = 30;
+  sp.stride = 3;
+  sp.novel = 25;
+  sp.away = 10;  // the last ten frames look away from the mirror (mirror_room's path always faces it)
+  const test::MapperScene s = test::make_mapper_scene(sp);
+  ASSERT_EQ(s.planes.size(), 1u);
+  MapperParams p;
+  GaussianMapper m(p, s.K, Device::cpu());
+  int skipped = 0, iterations = 0;
+  for (size_t i = 0; i < s.frames.size(); ++i) {
+    m.add_frame(s.frame(i), i % 5 == 0);
+    if (i % 10 == 9) {
+      const MappingStats st = m.step(s.context());
+      EXPECT_LE(st.reflection_skipped, st.iterations);
+      skipped += st.reflection_skipped;
+      iterations += st.iterations;
+    }
+  }
+  const auto snap = m.snapshot();
+  ASSERT_GT(snap->reflection.size(), 0u);
+  EXPECT_EQ(snap->reflection_planes, std::vector<int32_t>{s.planes[0].id});
+  Renderer full(Device::cpu(), p.render);
+  int drawn = 0, blank = 0;
+  for (const Eigen::Isometry3f& T : s.novel_poses) {
+    const RaycastResult rc = s.context().raycast(s.K, T);
+    Image<int32_t> I = rc.plane_ids.to_host();
+    for (const bool hide : {false, true}) {
+      if (hide)  // the mirror's pixels carry a plane that has no reflection Gaussians
+        for (int32_t& l : I.pixels()) l = l == s.planes[0].id ? s.planes[0].id + 1000 : l;
+      const auto I_dev = DeviceImage<int32_t>::from_host(I, Device::cpu());
+      RenderOutputs out;
+      full.render_reflection({s.K, T}, snap->reflection, I_dev, out);
+      const ColorImage want = out.C_r.to_host(), got = m.render_reflection({s.K, T}, I_dev);
+      ASSERT_EQ(got.size(), want.size());
+      bool nonzero = false;
+      for (size_t i = 0; i < want.size(); ++i) {
+        ASSERT_EQ(got[i], want[i]) << "pixel " << i << (hide ? " (mirror hidden)" : "");
+        nonzero = nonzero || want[i] != Color::Zero();
+      }
+      if (hide) EXPECT_FALSE(nonzero);
+      (nonzero ? drawn : blank) += 1;
+    }
+  }
+  EXPECT_GT(drawn, 0);  // some novel view shows the mirror's reflection: the comparison is not vacuous
+  std::printf("[ pass 3 skip ] %d of %d iterations without the mirror in view; %d novel renders drawn, %d blank\n",
+              skipped, iterations, drawn, blank);
+  EXPECT_GT(skipped, 0);
+  EXPECT_LT(skipped, iterations);
+}
+
 }  // namespace
 }  // namespace rrg
