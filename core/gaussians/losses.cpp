@@ -100,18 +100,22 @@ float depth_l1_loss(const DeviceImage<float>& d, const DeviceImage<float>& d_gt,
   return r;
 }
 
-float sobel_l1_loss(const DeviceImage<Color>& x, DeviceImage<Color>* v_x, float weight) {
+float sobel_l1_loss(const DeviceImage<Color>& x, DeviceImage<Color>* v_x, float weight, Buffer<int8_t>& scratch) {
   if (v_x) check_same(x, *v_x, "sobel_l1_loss (gradient)");
+  const size_t need = v_x ? size_t(x.width()) * size_t(x.height()) * 6 : 0;
+  if (scratch.size() < need || (need > 0 && scratch.device() != x.device())) scratch = Buffer<int8_t>(need, x.device());
+  const Span<int8_t> signs{scratch.data(), int64_t(need)};
   float r = 0;
-  RRG_DISPATCH(x.device(), r = kernel::sobel_l1_loss_cpu<float>(x.width(), x.height(), flat(x), flat_grad(v_x), weight),
-               r = kernel::sobel_l1_loss_cuda(x.width(), x.height(), flat(x), flat_grad(v_x), weight));
+  RRG_DISPATCH(x.device(),
+               r = kernel::sobel_l1_loss_cpu<float>(x.width(), x.height(), flat(x), flat_grad(v_x), weight, signs),
+               r = kernel::sobel_l1_loss_cuda(x.width(), x.height(), flat(x), flat_grad(v_x), weight, signs));
   return r;
 }
 
 LossValues mapping_loss(const DeviceImage<Color>& C, const DeviceImage<Color>& C_gt, const DeviceImage<float>& D_b,
                         const DeviceImage<float>& D_gt, const DeviceImage<Color>* C_r, const LossWeights& w,
                         DeviceImage<Color>& v_C, DeviceImage<float>& v_D_b, DeviceImage<Color>& v_C_r,
-                        Buffer<float>& ssim_scratch) {
+                        LossScratch& scratch) {
   w.validate();
   check_same(C, D_b, "mapping_loss (C, D_b)");
   const Device& dev = C.device();
@@ -119,11 +123,11 @@ LossValues mapping_loss(const DeviceImage<Color>& C, const DeviceImage<Color>& C
   zero_like(v_D_b, C.width(), C.height(), dev);
   LossValues L;
   L.l1 = l1_loss(C, C_gt, &v_C, 1.0f - w.lambda_ssim);
-  L.ssim = ssim(C, C_gt, &v_C, -w.lambda_ssim, ssim_scratch);  // ∂(λ(1 − SSIM)) = −λ ∂SSIM
+  L.ssim = ssim(C, C_gt, &v_C, -w.lambda_ssim, scratch.ssim);  // ∂(λ(1 − SSIM)) = −λ ∂SSIM
   L.depth_l1 = depth_l1_loss(D_b, D_gt, &v_D_b, w.lambda_depth);
   if (C_r && w.lambda_sobel > 0.0f) {
     zero_like(v_C_r, C.width(), C.height(), dev);
-    L.sobel = sobel_l1_loss(*C_r, &v_C_r, w.lambda_sobel);
+    L.sobel = sobel_l1_loss(*C_r, &v_C_r, w.lambda_sobel, scratch.sobel);
   } else {
     v_C_r = DeviceImage<Color>();
   }

@@ -30,14 +30,21 @@ float ssim(const DeviceImage<Color>& x, const DeviceImage<Color>& y, DeviceImage
 // mean |d − d_gt| over d_gt > 0 (0 when none); v_d += weight ∂/∂d.
 float depth_l1_loss(const DeviceImage<float>& d, const DeviceImage<float>& d_gt, DeviceImage<float>* v_d,
                     float weight);
-// mean (|Gx| + |Gy|) of the Sobel responses over interior pixels; v_x += weight ∂/∂x.
-float sobel_l1_loss(const DeviceImage<Color>& x, DeviceImage<Color>* v_x, float weight);
+// mean (|Gx| + |Gy|) of the Sobel responses over interior pixels; v_x += weight ∂/∂x. scratch (the
+// responses' signs, for the gradient) is resized as needed.
+float sobel_l1_loss(const DeviceImage<Color>& x, DeviceImage<Color>* v_x, float weight, Buffer<int8_t>& scratch);
+
+// Working memory of mapping_loss, kept by the caller between calls.
+struct LossScratch {
+  Buffer<float> ssim;
+  Buffer<int8_t> sobel;
+};
 
 // The whole mapping loss. Overwrites v_C, v_D_b (and v_C_r when C_r is given and λ_g > 0; else it
 // is left empty) with ∂L/∂C, ∂L/∂D_b, ∂L/∂C_r, allocated on the images' device.
 LossValues mapping_loss(const DeviceImage<Color>& C, const DeviceImage<Color>& C_gt, const DeviceImage<float>& D_b,
                         const DeviceImage<float>& D_gt, const DeviceImage<Color>* C_r, const LossWeights& w,
                         DeviceImage<Color>& v_C, DeviceImage<float>& v_D_b, DeviceImage<Color>& v_C_r,
-                        Buffer<float>& ssim_scratch);
+                        LossScratch& scratch);
 
 }  // namespace rrg

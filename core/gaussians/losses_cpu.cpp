@@ -17,15 +17,15 @@ T ssim_cpu(int w, int h, Span<const T> x, Span<const T> y, Span<T> v_x, T weight
   return ssim(CpuBackend{}, w, h, x, y, v_x, weight, win, scratch);
 }
 template <class T>
-T sobel_l1_loss_cpu(int w, int h, Span<const T> x, Span<T> v_x, T weight) {
-  return sobel_l1_loss(CpuBackend{}, w, h, x, v_x, weight);
+T sobel_l1_loss_cpu(int w, int h, Span<const T> x, Span<T> v_x, T weight, Span<int8_t> signs) {
+  return sobel_l1_loss(CpuBackend{}, w, h, x, v_x, weight, signs);
 }
 
 #define RRG_LOSSES_INSTANTIATE(T)                                                                  \
   template T l1_loss_cpu<T>(Span<const T>, Span<const T>, Span<T>, T);                             \
   template T depth_l1_loss_cpu<T>(Span<const T>, Span<const T>, Span<T>, T);                       \
   template T ssim_cpu<T>(int, int, Span<const T>, Span<const T>, Span<T>, T, SsimWindow<T>, Span<T>); \
-  template T sobel_l1_loss_cpu<T>(int, int, Span<const T>, Span<T>, T);
+  template T sobel_l1_loss_cpu<T>(int, int, Span<const T>, Span<T>, T, Span<int8_t>);
 RRG_LOSSES_INSTANTIATE(float)
 RRG_LOSSES_INSTANTIATE(double)
 #undef RRG_LOSSES_INSTANTIATE

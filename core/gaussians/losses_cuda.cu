@@ -20,8 +20,8 @@ float ssim_cuda(int w, int h, Span<const float> x, Span<const float> y, Span<flo
   RRG_CUDA_CHECK(cudaStreamSynchronize(nullptr));
   return r;
 }
-float sobel_l1_loss_cuda(int w, int h, Span<const float> x, Span<float> v_x, float weight) {
-  const float r = sobel_l1_loss(CudaBackend{}, w, h, x, v_x, weight);
+float sobel_l1_loss_cuda(int w, int h, Span<const float> x, Span<float> v_x, float weight, Span<int8_t> signs) {
+  const float r = sobel_l1_loss(CudaBackend{}, w, h, x, v_x, weight, signs);
   RRG_CUDA_CHECK(cudaStreamSynchronize(nullptr));
   return r;
 }

@@ -135,10 +135,14 @@ T ssim(Backend be, int w, int h, Span<const T> x, Span<const T> y, Span<T> v_x, 
 // |Gx| + |Gy|. Gradient gathered per pixel q from the 3×3 interior neighbours p:
 // Σ_p sign(Gx(p)) kx(q − p) + sign(Gy(p)) ky(q − p).
 template <class Backend, class T>
-T sobel_l1_loss(Backend be, int w, int h, Span<const T> x, Span<T> v_x, T weight) {
+T sobel_l1_loss(Backend be, int w, int h, Span<const T> x, Span<T> v_x, T weight, Span<int8_t> signs) {
   if (w < 3 || h < 3) return T(0);
   const T count = T(int64_t(w - 2) * (h - 2) * 3);
   const T* img = x.data;
+  const bool grad = !v_x.empty();
+  // With the gradient, the forward pass keeps sign(Gx), sign(Gy) of every interior element in
+  // `signs` ([2 w h 3]): the backward reads the nine responses around each element from there
+  // instead of recomputing each 3x3 Sobel nine times (the same values, so the same sums).
   const T total = parallel_reduce(
       be, int64_t(w) * h * 3, T(0),
       [=] RRG_HD(int64_t i) {
@@ -147,10 +151,14 @@ T sobel_l1_loss(Backend be, int w, int h, Span<const T> x, Span<T> v_x, T weight
         if (px < 1 || py < 1 || px > w - 2 || py > h - 2) return T(0);
         T gx, gy;
         sobel_at(img, w, px, py, ch, &gx, &gy);
+        if (grad) {
+          signs[2 * i] = int8_t(sign_of(gx));
+          signs[2 * i + 1] = int8_t(sign_of(gy));
+        }
         return abs_of(gx) + abs_of(gy);
       },
       [] RRG_HD(T a, T b) { return a + b; });
-  if (!v_x.empty()) {
+  if (grad) {
     const T s = weight / count;
     parallel_for(be, int64_t(w) * h * 3, [=] RRG_HD(int64_t i) {
       const int64_t q = i / 3;
@@ -160,9 +168,8 @@ T sobel_l1_loss(Backend be, int w, int h, Span<const T> x, Span<T> v_x, T weight
         for (int dx = -1; dx <= 1; ++dx) {
           const int px = qx - dx, py = qy - dy;  // q = p + (dx, dy)
           if (px < 1 || py < 1 || px > w - 2 || py > h - 2) continue;
-          T gx, gy;
-          sobel_at(img, w, px, py, ch, &gx, &gy);
-          g += sign_of(gx) * T(sobel_kx(dx, dy)) + sign_of(gy) * T(sobel_ky(dx, dy));
+          const int64_t j = (int64_t(py) * w + px) * 3 + ch;
+          g += T(signs[2 * j]) * T(sobel_kx(dx, dy)) + T(signs[2 * j + 1]) * T(sobel_ky(dx, dy));
         }
       v_x[i] += s * g;
     });
@@ -179,12 +186,12 @@ template <class T>
 T ssim_cpu(int w, int h, Span<const T> x, Span<const T> y, Span<T> v_x, T weight, SsimWindow<T> win,
            Span<T> scratch);
 template <class T>
-T sobel_l1_loss_cpu(int w, int h, Span<const T> x, Span<T> v_x, T weight);
+T sobel_l1_loss_cpu(int w, int h, Span<const T> x, Span<T> v_x, T weight, Span<int8_t> signs);
 
 float l1_loss_cuda(Span<const float> x, Span<const float> y, Span<float> v_x, float weight);
 float depth_l1_loss_cuda(Span<const float> d, Span<const float> d_gt, Span<float> v_d, float weight);
 float ssim_cuda(int w, int h, Span<const float> x, Span<const float> y, Span<float> v_x, float weight,
                 SsimWindow<float> win, Span<float> scratch);
-float sobel_l1_loss_cuda(int w, int h, Span<const float> x, Span<float> v_x, float weight);
+float sobel_l1_loss_cuda(int w, int h, Span<const float> x, Span<float> v_x, float weight, Span<int8_t> signs);
 
 }  // namespace rrg::kernel

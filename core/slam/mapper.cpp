@@ -323,7 +323,7 @@ MappingStats GaussianMapper::step(const MappingContext& ctx) {
     renderer_.render({K_, f.frame->T_wc}, base_, pass3 ? refl_ : no_reflection_, f.rc, out);
     const bool with_refl = reflections && refl_.size() > 0;
     const LossValues L = mapping_loss(out.C, f.C_gt, out.D_b, f.D_gt, with_refl ? &out.C_r : nullptr, lw, up.v_C,
-                                      up.v_D_b, up.v_C_r, ssim_scratch_);
+                                      up.v_D_b, up.v_C_r, loss_scratch_);
     loss_sum += L.total;
     renderer_.backward(up, v_base_, pass3 ? v_refl_ : v_no_reflection_);
     adam_base_.step(base_, v_base_);

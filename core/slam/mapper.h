@@ -174,7 +174,7 @@ class GaussianMapper {
   GaussianAdam adam_base_, adam_refl_;
   GaussianGrads v_base_, v_refl_, v_no_reflection_;
   Renderer renderer_;
-  Buffer<float> ssim_scratch_;
+  LossScratch loss_scratch_;
   uint64_t steps_ = 0;
 
   mutable std::mutex frames_mutex_;

@@ -111,11 +111,14 @@ TEST(Losses, SobelKnownAnswerAndFiniteDifferences) {
   for (int y = 0; y < H; ++y)
     for (int x = 0; x < W; ++x)
       for (int c = 0; c < 3; ++c) ramp[(size_t(y) * W + x) * 3 + c] = 0.05 * x;
-  EXPECT_NEAR(kernel::sobel_l1_loss_cpu<double>(W, H, cs(ramp), ms(none), 1.0), 8 * 0.05, 1e-12);
+  std::vector<int8_t> signs(size_t(W) * H * 6), no_signs;
+  const Span<int8_t> sg{signs.data(), int64_t(signs.size())}, no_sg{no_signs.data(), 0};
+  EXPECT_NEAR(kernel::sobel_l1_loss_cpu<double>(W, H, cs(ramp), ms(none), 1.0, no_sg), 8 * 0.05, 1e-12);
   std::vector<double> x = random_image(W, H, 3, 7), g(x.size(), 0.0);
-  kernel::sobel_l1_loss_cpu<double>(W, H, cs(x), ms(g), 1.0);
+  kernel::sobel_l1_loss_cpu<double>(W, H, cs(x), ms(g), 1.0, sg);
   // A step of h moves a response by at most 4h: random data puts none that close to the kink at 0.
-  const double err = fd_check(x, g, [&] { return kernel::sobel_l1_loss_cpu<double>(W, H, cs(x), ms(none), 1.0); }, 1e-7);
+  const double err =
+      fd_check(x, g, [&] { return kernel::sobel_l1_loss_cpu<double>(W, H, cs(x), ms(none), 1.0, no_sg); }, 1e-7);
   EXPECT_LT(err, 1e-6);
 }
 
@@ -134,7 +137,8 @@ TEST(Losses, FloatApiMatchesDoubleAndDevicesAgree) {
   const double l1 = kernel::l1_loss_cpu<double>(cs(xd), cs(yd), ms(vC), 0.8);
   const double ss = kernel::ssim_cpu<double>(W, H, cs(xd), cs(yd), ms(vC), -0.2, window_d(), ms(scratch));
   const double dl = kernel::depth_l1_loss_cpu<double>(cs(dd), cs(gtd), ms(vD), 0.2);
-  const double sb = kernel::sobel_l1_loss_cpu<double>(W, H, cs(rd), ms(vR), 0.05);
+  std::vector<int8_t> signs(size_t(W) * H * 6);
+  const double sb = kernel::sobel_l1_loss_cpu<double>(W, H, cs(rd), ms(vR), 0.05, {signs.data(), int64_t(signs.size())});
   const double total = 0.8 * l1 + 0.2 * (1 - ss) + 0.2 * dl + 0.05 * sb;
 
   const ColorImage X = to_color(xd, W, H), Y = to_color(yd, W, H), Rr = to_color(rd, W, H);
@@ -147,7 +151,7 @@ TEST(Losses, FloatApiMatchesDoubleAndDevicesAgree) {
         const auto Db = DeviceImage<float>::from_host(D, dev), Dgt = DeviceImage<float>::from_host(G, dev);
         DeviceImage<Color> v_C, v_Cr;
         DeviceImage<float> v_D;
-        Buffer<float> sc;
+        LossScratch sc;
         const LossValues L = mapping_loss(C, Cgt, Db, Dgt, &Cr, LossWeights{}, v_C, v_D, v_Cr, sc);
         std::vector<double> out = {L.total, L.l1, L.ssim, L.depth_l1, L.sobel};
         const ColorImage hC = v_C.to_host(), hCr = v_Cr.to_host();
