@@ -91,6 +91,21 @@ GaussianHost GaussianSet::to_host() const {
   return h;
 }
 
+GaussianSet GaussianSet::copy() const {
+  GaussianSet out(sh_degree_, device_, size_);
+  const auto same = [&](auto& dst, const auto& src, size_t count) {
+    mem::copy(dst.data(), device_, src.data(), device_, count * sizeof(*src.data()));
+  };
+  same(out.means_, means_, size_);
+  same(out.log_scales_, log_scales_, size_);
+  same(out.quats_, quats_, size_);
+  same(out.logit_opacities_, logit_opacities_, size_);
+  same(out.sh_, sh_, size_ * size_t(sh_coeffs()));
+  same(out.plane_ids_, plane_ids_, size_);
+  out.size_ = size_;
+  return out;
+}
+
 void GaussianSet::reserve(size_t n) {
   if (n <= capacity_) return;
   const size_t k = size_t(sh_coeffs());

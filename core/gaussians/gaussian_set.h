@@ -54,6 +54,8 @@ class GaussianSet {
   GaussianSet(int sh_degree, const Device& device, size_t capacity = 0);
   static GaussianSet from_host(const GaussianHost& host, const Device& device);
   GaussianHost to_host() const;
+  // An independent copy on the same device (device to device; capacity = size()).
+  GaussianSet copy() const;
 
   size_t size() const { return size_; }
   size_t capacity() const { return capacity_; }

@@ -352,10 +352,9 @@ MappingStats GaussianMapper::step(const MappingContext& ctx) {
 }
 
 void GaussianMapper::publish() {
-  const GaussianHost refl = refl_.to_host();
-  auto snap = std::make_shared<MapSnapshot>(MapSnapshot{GaussianSet::from_host(base_.to_host(), device_),
-                                                        GaussianSet::from_host(refl, device_), 0,
-                                                        distinct_planes(refl.plane_ids)});
+  // Device-to-device copies (no round trip through the host, which on CUDA crossed PCIe twice).
+  auto snap = std::make_shared<MapSnapshot>(
+      MapSnapshot{base_.copy(), refl_.copy(), 0, distinct_planes(plane_ids_host(refl_, device_))});
   std::lock_guard lock(snapshot_mutex_);
   snap->version = ++version_;
   snapshot_ = std::move(snap);

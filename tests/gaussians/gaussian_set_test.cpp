@@ -54,6 +54,32 @@ TEST(GaussianSet, RoundTripsThroughEveryDevice) {
   }
 }
 
+// copy() is a device-side copy: every field equal, and independent of the original afterwards.
+TEST(GaussianSet, CopyIsEqualAndIndependentOnEveryDevice) {
+  for (const Device& d : available_devices()) {
+    SCOPED_TRACE(d.to_string());
+    GaussianSet s = GaussianSet::from_host(tagged(37, 3), d);
+    s.append(tagged(5, 3, 37));  // capacity above size: copy() takes size() Gaussians
+    const GaussianSet c = s.copy();
+    EXPECT_EQ(c.size(), 42u);
+    EXPECT_EQ(c.sh_degree(), 3);
+    EXPECT_EQ(c.device(), d);
+    const GaussianHost want = s.to_host(), got = c.to_host();
+    EXPECT_EQ(got.means, want.means);
+    EXPECT_EQ(got.log_scales, want.log_scales);
+    EXPECT_EQ(got.quats, want.quats);
+    EXPECT_EQ(got.logit_opacities, want.logit_opacities);
+    EXPECT_EQ(got.sh, want.sh);
+    EXPECT_EQ(got.plane_ids, want.plane_ids);
+    expect_consistent(got);
+    std::vector<uint8_t> keep(s.size(), 0);  // empty the original: the copy keeps its Gaussians
+    s.prune(keep);
+    s.append(tagged(3, 3, 100));
+    EXPECT_EQ(c.to_host().means, want.means);
+    EXPECT_EQ(GaussianSet(2, d).copy().size(), 0u);
+  }
+}
+
 TEST(GaussianSet, AppendGrowsGeometricallyAndKeepsStorageWithinCapacity) {
   GaussianSet s(1, Device::cpu());
   s.append(tagged(100, 1));
