@@ -111,15 +111,34 @@ void Renderer::project(const kernel::View& view, const GaussianSet& set, Project
                kernel::project_splats_cuda(view, views_of(set), first(p.splats, n), first(p.rects, n)));
 }
 
-std::vector<int32_t> Renderer::reflection_groups() const {
-  const Span<const int32_t> l = refl_set_->plane_ids();
-  std::vector<int32_t> ids(size_t(l.size));
-  mem::copy(ids.data(), Device::cpu(), l.data, device_, ids.size() * sizeof(int32_t));
+std::vector<int32_t> distinct_planes(std::span<const int32_t> plane_ids) {
+  std::vector<int32_t> ids(plane_ids.begin(), plane_ids.end());
   std::sort(ids.begin(), ids.end());
   ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
   ids.erase(std::remove(ids.begin(), ids.end(), 0), ids.end());  // l = 0: no plane, never shown
   return ids;
 }
+
+std::vector<int32_t> distinct_planes(const GaussianSet& set) {
+  const Span<const int32_t> l = set.plane_ids();
+  std::vector<int32_t> ids(size_t(l.size));
+  mem::copy(ids.data(), Device::cpu(), l.data, set.device(), ids.size() * sizeof(int32_t));
+  return distinct_planes(std::span<const int32_t>(ids));
+}
+
+bool shows_any_plane(const Image<int32_t>& I, std::span<const int32_t> planes) {
+  if (planes.empty()) return false;
+  int32_t last = 0;  // runs of one id are common: test each run once
+  for (size_t i = 0; i < I.size(); ++i) {
+    const int32_t l = I[i];
+    if (l == 0 || l == last) continue;
+    if (std::binary_search(planes.begin(), planes.end(), l)) return true;
+    last = l;
+  }
+  return false;
+}
+
+std::vector<int32_t> Renderer::reflection_groups() const { return distinct_planes(*refl_set_); }
 
 void Renderer::render(const RenderCamera& camera, const GaussianSet& base, const GaussianSet& reflection,
                       const RaycastInputs& raycast, RenderOutputs& out) {

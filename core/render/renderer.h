@@ -15,9 +15,20 @@
 #include "core/render/splat.h"
 #include "core/render/tile_bins.h"
 
+#include <span>
 #include <vector>
 
 namespace rrg {
+
+// The sorted distinct non-zero plane ids l (the reflection groups) among plane_ids, or of a set's
+// Gaussians (copied to the host).
+std::vector<int32_t> distinct_planes(std::span<const int32_t> plane_ids);
+std::vector<int32_t> distinct_planes(const GaussianSet& set);
+// Whether pass 3 in its grouped form (a Gaussian reaches pixel u only when its plane id l equals
+// I(u) != 0) can draw anything over plane-id map I for Gaussians on `planes` (sorted): some pixel's
+// I(u) is one of them. When not, C_r = 0 and W_r = 0 everywhere and no reflection Gaussian gets a
+// gradient, so the pass can be skipped with identical results.
+bool shows_any_plane(const Image<int32_t>& I, std::span<const int32_t> planes);
 
 class Renderer {
  public:

@@ -77,34 +77,7 @@ int64_t prune_set(GaussianSet& set, GaussianAdam& adam, const PruneParams& p) {
   return int64_t(before - set.size());
 }
 
-std::vector<int32_t> plane_ids_host(const GaussianSet& set, const Device& device) {
-  const Span<const int32_t> l = set.plane_ids();
-  std::vector<int32_t> ids(size_t(l.size));
-  mem::copy(ids.data(), Device::cpu(), l.data, device, ids.size() * sizeof(int32_t));
-  return ids;
-}
-
 }  // namespace
-
-std::vector<int32_t> distinct_planes(std::span<const int32_t> plane_ids) {
-  std::vector<int32_t> ids(plane_ids.begin(), plane_ids.end());
-  std::sort(ids.begin(), ids.end());
-  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-  ids.erase(std::remove(ids.begin(), ids.end(), 0), ids.end());
-  return ids;
-}
-
-bool shows_any_plane(const Image<int32_t>& I, std::span<const int32_t> planes) {
-  if (planes.empty()) return false;
-  int32_t last = 0;  // runs of one id are common: test each run once
-  for (size_t i = 0; i < I.size(); ++i) {
-    const int32_t l = I[i];
-    if (l == 0 || l == last) continue;
-    if (std::binary_search(planes.begin(), planes.end(), l)) return true;
-    last = l;
-  }
-  return false;
-}
 
 CompactFrame CompactFrame::from(const MappingFrame& frame) {
   CompactFrame s;
@@ -306,7 +279,7 @@ MappingStats GaussianMapper::step(const MappingContext& ctx) {
   // Gaussians without gradient as they are), without projecting, binning and walking all of them.
   t0 = Clock::now();
   if (params_.render.variant != ReflectionVariant::NoPlaneGrouping && refl_.size() > 0) {
-    const std::vector<int32_t> planes = distinct_planes(plane_ids_host(refl_, device_));
+    const std::vector<int32_t> planes = distinct_planes(refl_);
     for (StepFrame& f : frames) f.shows_reflection = shows_any_plane(f.rc.I.to_host(), planes);
   }
   std::vector<size_t> order(frames.size());
@@ -354,7 +327,7 @@ MappingStats GaussianMapper::step(const MappingContext& ctx) {
 void GaussianMapper::publish() {
   // Device-to-device copies (no round trip through the host, which on CUDA crossed PCIe twice).
   auto snap = std::make_shared<MapSnapshot>(
-      MapSnapshot{base_.copy(), refl_.copy(), 0, distinct_planes(plane_ids_host(refl_, device_))});
+      MapSnapshot{base_.copy(), refl_.copy(), 0, distinct_planes(refl_)});
   std::lock_guard lock(snapshot_mutex_);
   snap->version = ++version_;
   snapshot_ = std::move(snap);

@@ -34,7 +34,6 @@
 #include <functional>
 #include <memory>
 #include <mutex>
-#include <span>
 #include <vector>
 
 namespace rrg {
@@ -119,13 +118,6 @@ struct MapSnapshot {             // immutable once published
   std::vector<int32_t> reflection_planes;  // the distinct non-zero plane ids l of `reflection`, sorted
 };
 
-// Whether pass 3 in its grouped form (a Gaussian reaches pixel u only when its plane id l equals
-// I(u) != 0) can draw anything over plane-id map I for Gaussians on `planes` (sorted): some pixel's
-// I(u) is one of them. When not, C_r = 0 and W_r = 0 everywhere and no reflection Gaussian gets a
-// gradient, so the pass can be skipped with identical results.
-bool shows_any_plane(const Image<int32_t>& I, std::span<const int32_t> planes);
-// The sorted distinct non-zero plane ids of a set's Gaussians.
-std::vector<int32_t> distinct_planes(std::span<const int32_t> plane_ids);
 
 class GaussianMapper {
  public:
