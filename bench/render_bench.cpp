@@ -17,15 +17,20 @@ namespace {
 
 using namespace rrg;
 
-GaussianHost bench_gaussians(int n, float z0, float z1, bool planes, uint32_t seed) {
+// n Gaussians in the frustum at depths z0..z1, then `away` more that no pixel can see: half behind
+// the camera, half in front of it but outside the field of view (the rest of a map larger than the
+// view, as in a room scanned from its middle).
+GaussianHost bench_gaussians(int n, float z0, float z1, bool planes, uint32_t seed, int away = 0) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> u(-1.0f, 1.0f), u01(0.0f, 1.0f);
   GaussianHost g(3);
-  g.resize(size_t(n));
+  g.resize(size_t(n + away));
   const float f640 = 525.0f;
-  for (int i = 0; i < n; ++i) {
+  for (int i = 0; i < n + away; ++i) {
     const float z = z0 + (z1 - z0) * u01(rng);
     g.means[i] = {0.62f * z * u(rng), 0.47f * z * u(rng), z};
+    if (i >= n && i % 2 == 0) g.means[i].z() = -z;  // behind the camera
+    if (i >= n && i % 2 == 1) g.means[i].x() = (u(rng) < 0 ? -1.0f : 1.0f) * z * (1.5f + u01(rng));  // beside the view
     for (int a = 0; a < 3; ++a) g.log_scales[i][a] = std::log(z / f640 * (1.0f + 3.0f * u01(rng)));
     g.quats[i] = Eigen::Vector4f(u(rng), u(rng), u(rng), u(rng)) + Eigen::Vector4f(0.5f, 0, 0, 0);
     g.logit_opacities[i] = 2.0f * u(rng);
@@ -42,12 +47,12 @@ struct Scene {
   RenderUpstream upstream;
 };
 
-Scene make_scene(int w, int h, int n, const Device& device) {
+Scene make_scene(int w, int h, int n, int away, const Device& device) {
   Scene s;
   const float f = 525.0f * float(w) / 640.0f;
   s.camera.K = {f, f, 0.5f * float(w - 1), 0.5f * float(h - 1), w, h};
-  s.base = std::make_unique<GaussianSet>(GaussianSet::from_host(bench_gaussians(n, 1.0f, 4.5f, false, 1), device));
-  s.refl = std::make_unique<GaussianSet>(GaussianSet::from_host(bench_gaussians(n, 2.5f, 6.0f, true, 2), device));
+  s.base = std::make_unique<GaussianSet>(GaussianSet::from_host(bench_gaussians(n, 1.0f, 4.5f, false, 1, away), device));
+  s.refl = std::make_unique<GaussianSet>(GaussianSet::from_host(bench_gaussians(n, 2.5f, 6.0f, true, 2, away), device));
   ColorImage C_t(w, h), v_C(w, h);
   DepthImage D_t(w, h), v_D(w, h);
   Image<int32_t> I(w, h);
@@ -68,8 +73,8 @@ Scene make_scene(int w, int h, int n, const Device& device) {
   return s;
 }
 
-void BM_Render(benchmark::State& state, Device device, int w, int h, int n, ReflectionVariant variant) {
-  Scene s = make_scene(w, h, n, device);
+void BM_Render(benchmark::State& state, Device device, int w, int h, int n, int away, ReflectionVariant variant) {
+  Scene s = make_scene(w, h, n, away, device);
   RenderParams p;
   p.variant = variant;
   p.time_stages = true;
@@ -105,11 +110,19 @@ const bool registered = [] {
         for (auto v : {ReflectionVariant::Grouped, ReflectionVariant::NoPlaneGrouping, ReflectionVariant::MultiPass}) {
           const std::string name = "render/" + device.to_string() + "/" + std::to_string(w) + "x" + std::to_string(h) +
                                    "/" + std::to_string(n / 1000) + "k/" + to_string(v);
-          benchmark::RegisterBenchmark(name.c_str(), BM_Render, device, w, h, n, v)
+          benchmark::RegisterBenchmark(name.c_str(), BM_Render, device, w, h, n, 0, v)
               ->Unit(benchmark::kMillisecond)
               ->UseRealTime()
               ->Iterations(device.is_cpu() ? 2 : 20);
         }
+  // A map five times the view: 100k Gaussians per set in view and 400k per set out of it. Against
+  // render/<device>/640x480/100k/grouped, what the out-of-view part of a map costs per iteration.
+  for (const Device& device : available_devices())
+    benchmark::RegisterBenchmark(("render/" + device.to_string() + "/640x480/100k+400k-away/grouped").c_str(), BM_Render,
+                                 device, 640, 480, 100000, 400000, ReflectionVariant::Grouped)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime()
+        ->Iterations(device.is_cpu() ? 4 : 20);
   return true;
 }();
 

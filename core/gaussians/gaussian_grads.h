@@ -15,13 +15,17 @@ struct GaussianGrads {
   Buffer<Eigen::Vector3f> v_sh;               // [N, K, 3]
   // [N] 1 where some gradient of Gaussian i is non-zero (the Gaussians a view saw), 0 elsewhere;
   // written by the renderer's backward. Empty when unknown: GaussianAdam then reads the gradients.
+  // When it is given, the gradient of a Gaussian marked 0 is zero whatever its v_* entries hold:
+  // the renderer's backward leaves those unwritten (most of a large map is out of any one view),
+  // so readers go through the marks, as GaussianAdam does.
   Buffer<uint8_t> touched;
 
   // Zero gradients for n Gaussians with k SH coefficients each, on device (reuses memory when the
   // sizes already match); `touched` is left empty.
   void reset(size_t n, int k, const Device& device);
   // Buffers (touched included) for n Gaussians with k SH coefficients, contents left as they are:
-  // for a writer that sets every entry (the renderer's backward). Reuses memory when sizes match.
+  // for a writer that sets every mark and the entries of the marked (the renderer's backward).
+  // Reuses memory when sizes match.
   void resize(size_t n, int k, const Device& device);
 };
 

@@ -92,31 +92,6 @@ RRG_TU_LOCAL RRG_HD inline bool projection_terms(const ViewT<T>& v, const Gaussi
   return pr.det > T(0);
 }
 
-// Forward: the splat and its screen radius (pixels, capped). False when culled.
-template <class T, class S>
-RRG_HD inline bool project_gaussian(const ViewT<T>& v, const GaussianInT<T, S>& g, SplatT<T>& out, T& radius) {
-  ProjectionT<T> pr;
-  if (!projection_terms(v, g, pr)) return false;
-  const T z = pr.p_c.z();
-  out.mean[0] = v.fx * pr.p_c.x() / z + v.cx;
-  out.mean[1] = v.fy * pr.p_c.y() / z + v.cy;
-  out.conic[0] = pr.C / pr.det;
-  out.conic[1] = -pr.B / pr.det;
-  out.conic[2] = pr.A / pr.det;
-  out.opacity = sigmoid(g.logit_opacity);
-  const Vec3<T> c = sh_color<T, S>(v.sh_degree, g.sh, g.mean, v.center());
-  out.color[0] = c.x();
-  out.color[1] = c.y();
-  out.color[2] = c.z();
-  out.depth = z;
-  const T mid = T(0.5) * (pr.A + pr.C);
-  const T disc = mid * mid - pr.det;
-  const T lambda_max = mid + k_sqrt(disc > T(0.1) ? disc : T(0.1));
-  radius = k_ceil(T(3) * k_sqrt(lambda_max));
-  if (radius > v.max_radius) radius = v.max_radius;
-  return true;
-}
-
 // Tiles touched by a splat of the given radius around p_hat (pixel centres at integer coordinates).
 template <class T>
 RRG_HD inline TileRect tile_rect(const ViewT<T>& v, const SplatT<T>& s, T radius) {
@@ -128,6 +103,43 @@ RRG_HD inline TileRect tile_rect(const ViewT<T>& v, const SplatT<T>& s, T radius
   r.y0 = clampi(int(k_floor((s.mean[1] - radius) / ts)), 0, v.tiles_y());
   r.y1 = clampi(int(k_floor((s.mean[1] + radius) / ts)) + 1, 0, v.tiles_y());
   return r;
+}
+
+// Forward: the splat and its screen radius (pixels, capped). False when culled: behind the near
+// plane, degenerate, or touching no tile of the image (the rest of a map larger than the view),
+// which is decided from the footprint before the opacity and the SH colour are evaluated.
+template <class T, class S>
+RRG_HD inline bool project_gaussian(const ViewT<T>& v, const GaussianInT<T, S>& g, SplatT<T>& out, T& radius) {
+  {
+    // A centre more than the radius cap beyond the image leaves every tile empty whatever the
+    // covariance: culled before it is formed.
+    const Vec3<T> p = v.R() * g.mean + v.t();
+    if (!(p.z() >= v.near_plane)) return false;
+    const T u = v.fx * p.x() / p.z() + v.cx, w = v.fy * p.y() / p.z() + v.cy;
+    const T W = T(v.tiles_x() * kTileSize), H = T(v.tiles_y() * kTileSize);
+    if (u + v.max_radius < T(0) || u - v.max_radius >= W || w + v.max_radius < T(0) || w - v.max_radius >= H) return false;
+  }
+  ProjectionT<T> pr;
+  if (!projection_terms(v, g, pr)) return false;
+  const T z = pr.p_c.z();
+  out.mean[0] = v.fx * pr.p_c.x() / z + v.cx;
+  out.mean[1] = v.fy * pr.p_c.y() / z + v.cy;
+  const T mid = T(0.5) * (pr.A + pr.C);
+  const T disc = mid * mid - pr.det;
+  const T lambda_max = mid + k_sqrt(disc > T(0.1) ? disc : T(0.1));
+  radius = k_ceil(T(3) * k_sqrt(lambda_max));
+  if (radius > v.max_radius) radius = v.max_radius;
+  if (tile_rect(v, out, radius).count() == 0) return false;
+  out.conic[0] = pr.C / pr.det;
+  out.conic[1] = -pr.B / pr.det;
+  out.conic[2] = pr.A / pr.det;
+  out.opacity = sigmoid(g.logit_opacity);
+  const Vec3<T> c = sh_color<T, S>(v.sh_degree, g.sh, g.mean, v.center());
+  out.color[0] = c.x();
+  out.color[1] = c.y();
+  out.color[2] = c.z();
+  out.depth = z;
+  return true;
 }
 
 // Gradients of one Gaussian's parameters from the gradient of its splat (v_sh accumulates, the rest

@@ -259,7 +259,8 @@ void Renderer::backward(const RenderUpstream& up, GaussianGrads& v_base, Gaussia
     RRG_DISPATCH(device_, kernel::composite_bwd_cpu(up.v_C.view(), in.R.view(), extra, has_v_C_r, v_C_r_.view()),
                  kernel::composite_bwd_cuda(up.v_C.view(), in.R.view(), extra, has_v_C_r, v_C_r_.view()));
     reflection_backward(vr, v_C_r_);
-    // splat gradients -> Gaussian parameters (project_bwd writes every entry, `touched` included)
+    // splat gradients -> Gaussian parameters (project_bwd writes `touched` and the v_* of the
+    // touched Gaussians only)
     v_base.resize(size_t(nb), base.sh_coeffs(), device_);
     v_reflection.resize(size_t(nr), refl.sh_coeffs(), device_);
     RRG_DISPATCH(device_, kernel::project_bwd_cpu(vb, views_of(base), first(base_.v_splats, nb), views_of(v_base)),

@@ -51,7 +51,9 @@ class Renderer {
                          RenderOutputs& out);
 
   // Gradients of every parameter of both sets (not the TSDF maps) for the last render(), given
-  // dL/dC, dL/dD_b and optionally dL/dC_r. Overwrites v_base and v_reflection.
+  // dL/dC, dL/dD_b and optionally dL/dC_r. Writes `touched` of v_base and v_reflection, and their
+  // v_* entries where touched = 1; where it is 0 the gradient is zero and the entries keep whatever
+  // they held (GaussianGrads).
   void backward(const RenderUpstream& upstream, GaussianGrads& v_base, GaussianGrads& v_reflection);
 
   const RenderTimings& timings() const { return timings_; }

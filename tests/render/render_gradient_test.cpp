@@ -18,7 +18,8 @@ struct Grads {
   GaussianHost base, refl;  // gradients stored in a GaussianHost layout (v_* per field)
 };
 
-GaussianHost to_host_grads(const GaussianGrads& g, int degree) {
+// The gradient buffers as they are, in a GaussianHost layout.
+GaussianHost raw_host_grads(const GaussianGrads& g, int degree) {
   GaussianHost h(degree);
   h.means = g.v_means.to_host();
   h.log_scales = g.v_log_scales.to_host();
@@ -26,6 +27,24 @@ GaussianHost to_host_grads(const GaussianGrads& g, int degree) {
   h.logit_opacities = g.v_logit_opacities.to_host();
   h.sh = g.v_sh.to_host();
   h.plane_ids.assign(h.means.size(), 0);
+  return h;
+}
+
+// The gradients as the renderer defines them: v_* where touched = 1, zero where it is 0 (those
+// entries are not written). A wrong mark therefore shows in every comparison below.
+GaussianHost to_host_grads(const GaussianGrads& g, int degree) {
+  GaussianHost h = raw_host_grads(g, degree);
+  const std::vector<uint8_t> touched = g.touched.to_host();
+  if (touched.size() != h.size()) throw std::logic_error("to_host_grads: touched has the wrong size");
+  const size_t K = size_t(h.sh_coeffs());
+  for (size_t i = 0; i < h.size(); ++i) {
+    if (touched[i]) continue;
+    h.means[i].setZero();
+    h.log_scales[i].setZero();
+    h.quats[i].setZero();
+    h.logit_opacities[i] = 0.0f;
+    for (size_t k = 0; k < K; ++k) h.sh[i * K + k].setZero();
+  }
   return h;
 }
 
@@ -178,7 +197,9 @@ TEST(RenderGradient, MultiPassGradientsEqualGroupedGradients) {
 }
 
 // `touched` marks exactly the Gaussians with a non-zero gradient (what GaussianAdam updates): one
-// appended behind the camera and one far outside the view get 0 and all-zero gradients.
+// appended behind the camera and one far outside the view get 0. Into zeroed buffers the unmarked
+// Gaussians' gradients stay zero; into buffers holding a sentinel the marked entries are the same
+// and the unmarked ones keep the sentinel (the backward does not write them).
 TEST(RenderGradient, TouchedMarksExactlyTheGaussiansWithAGradient) {
   SmallScene s = small_scene(11);
   const size_t n0 = s.base.size();
@@ -198,21 +219,49 @@ TEST(RenderGradient, TouchedMarksExactlyTheGaussiansWithAGradient) {
     Renderer r(device, RenderParams{});
     RenderOutputs out;
     r.render(s.camera, base, refl, in, out);
-    GaussianGrads gb, gr;
+    // zeroed buffers, and buffers holding a sentinel in every entry
+    GaussianGrads gb, gr, sb, sr;
+    gb.reset(base.size(), base.sh_coeffs(), device);
+    gr.reset(refl.size(), refl.sh_coeffs(), device);
+    constexpr float kSentinel = 7.0f;
+    for (auto [g, set] : {std::pair{&sb, &base}, std::pair{&sr, &refl}}) {
+      const size_t n = set->size(), K = size_t(set->sh_coeffs());
+      g->resize(n, int(K), device);
+      g->v_means.copy_from_host(std::vector<Eigen::Vector3f>(n, Eigen::Vector3f::Constant(kSentinel)));
+      g->v_log_scales.copy_from_host(std::vector<Eigen::Vector3f>(n, Eigen::Vector3f::Constant(kSentinel)));
+      g->v_quats.copy_from_host(std::vector<Eigen::Vector4f>(n, Eigen::Vector4f::Constant(kSentinel)));
+      g->v_logit_opacities.copy_from_host(std::vector<float>(n, kSentinel));
+      g->v_sh.copy_from_host(std::vector<Eigen::Vector3f>(n * K, Eigen::Vector3f::Constant(kSentinel)));
+    }
     r.backward(to_device(up, device), gb, gr);
-    for (const auto* g : {&gb, &gr}) {
-      const GaussianHost h = to_host_grads(*g, g == &gb ? s.base.sh_degree : s.refl.sh_degree);
+    r.backward(to_device(up, device), sb, sr);
+    for (auto [g, sent] : {std::pair{&gb, &sb}, std::pair{&gr, &sr}}) {
+      const int degree = g == &gb ? s.base.sh_degree : s.refl.sh_degree;
+      const GaussianHost h = raw_host_grads(*g, degree), hs = raw_host_grads(*sent, degree);
       const std::vector<uint8_t> touched = g->touched.to_host();
       ASSERT_EQ(touched.size(), h.size());
+      ASSERT_EQ(sent->touched.to_host(), touched);
       size_t marked = 0;
+      const size_t K = size_t(h.sh_coeffs());
       for (size_t i = 0; i < h.size(); ++i) {
         bool nonzero = h.logit_opacities[i] != 0.0f || !h.means[i].isZero(0.0f) || !h.log_scales[i].isZero(0.0f) ||
                        !h.quats[i].isZero(0.0f);
-        for (int k = 0; k < h.sh_coeffs(); ++k) nonzero = nonzero || !h.sh[i * size_t(h.sh_coeffs()) + size_t(k)].isZero(0.0f);
+        for (size_t k = 0; k < K; ++k) nonzero = nonzero || !h.sh[i * K + k].isZero(0.0f);
         EXPECT_EQ(touched[i] != 0, nonzero) << i;
         marked += touched[i];
+        // marked: written, the same values; unmarked: left as they were
+        const auto expected = [&](auto x) {
+          if (!touched[i]) x.setConstant(kSentinel);
+          return x;
+        };
+        EXPECT_EQ(hs.means[i], expected(h.means[i])) << i;
+        EXPECT_EQ(hs.log_scales[i], expected(h.log_scales[i])) << i;
+        EXPECT_EQ(hs.quats[i], expected(h.quats[i])) << i;
+        EXPECT_EQ(hs.logit_opacities[i], touched[i] ? h.logit_opacities[i] : kSentinel) << i;
+        for (size_t k = 0; k < K; ++k) EXPECT_EQ(hs.sh[i * K + k], expected(h.sh[i * K + k])) << i << " sh " << k;
       }
       EXPECT_GT(marked, 0u);
+      EXPECT_LT(marked, h.size());
     }
     const std::vector<uint8_t> tb = gb.touched.to_host();
     EXPECT_EQ(tb[n0], 0);
