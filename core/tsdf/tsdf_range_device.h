@@ -62,44 +62,57 @@ RRG_HD inline void range_at(const RangeImage& r, int x, int y, float& near, floa
   far = bits_float(r.far[t]);
 }
 
-// Projects block `key` (camera R_cw, t_cw) into the tiles it may cover.
+// Projects block `key` (camera R_cw, t_cw) into the tiles it may cover. The march samples depths
+// z >= min_depth only, so the footprint is that of the box clipped by the plane z = min_depth: the
+// bounding rectangle of the projections of the corners in front of the plane and of the points
+// where the box's edges cross it (the clipped box is convex, so its image is the hull of its
+// vertices' images). A block straddling the camera's plane therefore covers what it can reach, not
+// the whole image: next to a wall or floor beside the camera such blocks used to pull every tile's
+// near bound down to min_depth.
 RRG_TU_LOCAL RRG_HD inline void range_splat_block(const RangeImage& r, uint64_t key, float voxel_size, const Intrinsics& K,
                                      const Eigen::Matrix3f& R_cw, const Eigen::Vector3f& t_cw, float min_depth,
                                      float max_depth) {
   const Eigen::Vector3f lo = (block_coord(key) * int(kBlockSide)).cast<float>() * voxel_size;
   const float side = float(kBlockSide) * voxel_size;
+  Eigen::Vector3f q[8];
   float z_lo = kNoDepth, z_hi = 0.0f;
+  for (int c = 0; c < 8; ++c) {
+    q[c] = R_cw * (lo + side * Eigen::Vector3f(float(c & 1), float((c >> 1) & 1), float(c >> 2))) + t_cw;
+    z_lo = min_f(z_lo, q[c].z());
+    z_hi = max_f(z_hi, q[c].z());
+  }
+  const float z_clip = max_f(min_depth, 1e-4f);
+  if (z_hi < z_clip || z_lo > max_depth) return;
   float u_lo = kNoDepth, u_hi = -kNoDepth;
   float v_lo = kNoDepth, v_hi = -kNoDepth;
-  bool behind = false;  // a corner at or behind the camera plane: the footprint is unbounded
-  for (int c = 0; c < 8; ++c) {
-    const Eigen::Vector3f p = lo + side * Eigen::Vector3f(float(c & 1), float((c >> 1) & 1), float(c >> 2));
-    const Eigen::Vector3f q = R_cw * p + t_cw;
-    z_lo = min_f(z_lo, q.z());
-    z_hi = max_f(z_hi, q.z());
-    if (q.z() <= 1e-4f) {
-      behind = true;
-      continue;
-    }
-    const Eigen::Vector2f uv = K.project(q);
+  const auto add = [&](const Eigen::Vector3f& p) {
+    const Eigen::Vector2f uv = K.project(p);
     u_lo = min_f(u_lo, uv.x());
     u_hi = max_f(u_hi, uv.x());
     v_lo = min_f(v_lo, uv.y());
     v_hi = max_f(v_hi, uv.y());
+  };
+  for (int c = 0; c < 8; ++c) {
+    if (q[c].z() >= z_clip) add(q[c]);
+    for (int axis = 0; axis < 3; ++axis) {  // the 12 edges, each once from its lower corner
+      const int d = c | (1 << axis);
+      if (d == c) continue;
+      const Eigen::Vector3f &a = q[c], &b = q[d];
+      if ((a.z() < z_clip) == (b.z() < z_clip)) continue;
+      const float t = (z_clip - a.z()) / (b.z() - a.z());
+      Eigen::Vector3f x = a + t * (b - a);
+      x.z() = z_clip;  // on the plane, whatever the rounding of the interpolation
+      add(x);
+    }
   }
-  if (z_hi < min_depth || z_lo > max_depth) return;
   z_lo = max_f(z_lo, min_depth);
-  int tx0 = 0, ty0 = 0, tx1 = r.tiles_x - 1, ty1 = r.tiles_y - 1;
-  if (!behind) {  // one pixel of slack for rounding
-    if (u_hi < -1.0f || v_hi < -1.0f || u_lo > float(K.width) || v_lo > float(K.height)) return;
-    const auto tile = [](float u, int n) {  // clamped before the conversion (u may be huge)
-      return floor_to_int(min_f(max_f(u / float(kRangeTile), 0.0f), float(n - 1)));
-    };
-    tx0 = tile(u_lo - 1.0f, r.tiles_x);
-    ty0 = tile(v_lo - 1.0f, r.tiles_y);
-    tx1 = tile(u_hi + 1.0f, r.tiles_x);
-    ty1 = tile(v_hi + 1.0f, r.tiles_y);
-  }
+  // one pixel of slack for rounding
+  if (u_hi < -1.0f || v_hi < -1.0f || u_lo > float(K.width) || v_lo > float(K.height)) return;
+  const auto tile = [](float u, int n) {  // clamped before the conversion (u may be huge)
+    return floor_to_int(min_f(max_f(u / float(kRangeTile), 0.0f), float(n - 1)));
+  };
+  const int tx0 = tile(u_lo - 1.0f, r.tiles_x), ty0 = tile(v_lo - 1.0f, r.tiles_y);
+  const int tx1 = tile(u_hi + 1.0f, r.tiles_x), ty1 = tile(v_hi + 1.0f, r.tiles_y);
   const int32_t near_neg = -float_bits(z_lo), far = float_bits(z_hi);
   for (int ty = ty0; ty <= ty1; ++ty)
     for (int tx = tx0; tx <= tx1; ++tx) {

@@ -1,6 +1,7 @@
 // The fast raycast (range image, block skipping, TSDF-sized steps, secant refinement) against a
 // brute-force reference that samples the same trilinear TSDF every 0.05 voxel from min_depth and
 // bisects the first +/− crossing: same hit/miss away from silhouettes, depth within 0.05 voxel.
+#include "core/tsdf/tsdf_range_device.h"
 #include "core/tsdf/tsdf_raycast.h"
 #include "core/tsdf/tsdf_sample_device.h"
 #include "tests/tsdf/analytic_scene.h"
@@ -9,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace rrg {
 namespace {
@@ -122,6 +124,62 @@ TEST(TsdfRaycast, FastMarchAgreesFromFarAndFromInside) {
     const Comparison c = compare_with_reference(volume, kSmallK, T);
     EXPECT_EQ(c.hit_mismatch, 0);
     EXPECT_LT(c.worst_depth, 0.05f * volume.params().voxel_size);
+  }
+}
+
+// The range image of blocks that straddle the camera's plane (a wall or floor beside the camera):
+// conservative, since every point of a block at a depth the march samples (>= min_depth) that
+// projects into the image lies in a covered tile whose [near, far] holds its depth; and tight, since
+// it covers the part of the image the clipped block can reach, not the whole image (it did: every
+// tile's near bound fell to min_depth). Camera at the origin looking along +z, 2 cm voxels
+// (16 cm blocks), the volume shifted 12 cm along the view so each block spans z from -4 to 12 cm.
+TEST(TsdfRaycast, RangeOfABlockAcrossTheCameraPlaneIsConservativeAndTight) {
+  const float voxel = 0.02f, side = 8 * voxel, min_depth = 0.1f, max_depth = 5.0f;
+  const Eigen::Matrix3f R_cw = Eigen::Matrix3f::Identity();
+  const Eigen::Vector3f t_cw(0.0f, 0.0f, 0.12f);
+  const int tiles_x = (kSmallK.width + kernel::kRangeTile - 1) / kernel::kRangeTile;
+  const int tiles_y = (kSmallK.height + kernel::kRangeTile - 1) / kernel::kRangeTile;
+  // block (-1, -1, -1): x, y in [-16, 0] cm, the upper left of the view; block (2, 0, -1): x in
+  // [32, 48] cm, beyond the image's right edge at every depth it has in front of min_depth
+  for (const Eigen::Vector3i b : {Eigen::Vector3i(-1, -1, -1), Eigen::Vector3i(2, 0, -1)}) {
+    SCOPED_TRACE("block " + std::to_string(b.x()) + " " + std::to_string(b.y()) + " " + std::to_string(b.z()));
+    std::vector<int32_t> near_neg(size_t(tiles_x * tiles_y)), far(size_t(tiles_x * tiles_y));
+    const kernel::RangeImage range{{near_neg.data(), int64_t(near_neg.size())}, {far.data(), int64_t(far.size())},
+                                   tiles_x, tiles_y};
+    for (int64_t t = 0; t < int64_t(near_neg.size()); ++t) kernel::range_clear(range, t);
+    kernel::range_splat_block(range, block_key(b.x(), b.y(), b.z()), voxel, kSmallK, R_cw, t_cw, min_depth, max_depth);
+    int covered = 0;
+    for (int y = 0; y < kSmallK.height; y += kernel::kRangeTile)
+      for (int x = 0; x < kSmallK.width; x += kernel::kRangeTile) {
+        float n, f;
+        kernel::range_at(range, x, y, n, f);
+        covered += n <= f;
+      }
+    // every point of the box in front of min_depth that the image sees: covered, depth within
+    int seen = 0;
+    const Eigen::Vector3f lo = b.cast<float>() * side;
+    for (int i = 0; i <= 40; ++i)
+      for (int j = 0; j <= 40; ++j)
+        for (int k = 0; k <= 40; ++k) {
+          const Eigen::Vector3f q = R_cw * (lo + side * Eigen::Vector3f(float(i), float(j), float(k)) / 40.0f) + t_cw;
+          if (q.z() < min_depth) continue;
+          const Eigen::Vector2f uv = kSmallK.project(q);
+          const int x = int(std::floor(uv.x() + 0.5f)), y = int(std::floor(uv.y() + 0.5f));
+          if (x < 0 || y < 0 || x >= kSmallK.width || y >= kSmallK.height) continue;
+          ++seen;
+          float n, f;
+          kernel::range_at(range, x, y, n, f);
+          ASSERT_LE(n, q.z() + 1e-6f) << "pixel " << x << " " << y;
+          ASSERT_GE(f, q.z() - 1e-6f) << "pixel " << x << " " << y;
+        }
+    if (b.x() < 0) {
+      EXPECT_GT(seen, 1000);
+      EXPECT_GT(covered, 0);
+      EXPECT_LT(covered, tiles_x * tiles_y * 3 / 4);  // about the upper-left quarter, not all
+    } else {
+      EXPECT_EQ(seen, 0);
+      EXPECT_EQ(covered, 0);
+    }
   }
 }
 
