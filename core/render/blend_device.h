@@ -194,6 +194,15 @@ RRG_HD inline bool refl_step(ReflStateT<T>& st, const SplatT<T>& s, T px, T py) 
   return true;
 }
 
+// Whether the mean RGB of C_r so far is above `stop`. C_r only grows along a pixel's list (weights
+// alpha T >= 0, colours max(SH + 0.5, 0) >= 0, per channel), so once it is above it stays above: a
+// caller that needs only that test (the tracking mask, mask_source.h: the same sum / 3 > threshold)
+// may stop compositing the pixel there. +inf never stops.
+template <class T>
+RRG_HD inline bool refl_mean_above(const ReflStateT<T>& st, T stop) {
+  return st.C.sum() / T(3) > stop;
+}
+
 // Backward of refl_step, replayed front to back with the final C_r, W_r of the pixel:
 // dC/dalpha_i = T_i c_i - (C - P_i) / (1 - alpha_i), P_i the colour up to and including i.
 template <class T>

@@ -155,7 +155,8 @@ void refl_fwd_cpu(ReflFwdArgs a) {
         for (int x = p.x0; x < p.x1; ++x) {
           const int l = tp.local(x, y);
           if (!alive[l] || (a.mode == PlaneMode::Match && a.plane_ids[g] != I[l])) continue;  // 1(l_i == I(u))
-          if (!refl_step(st[l], s, float(x), float(y))) alive[l] = false, --live;           // early termination
+          if (!refl_step(st[l], s, float(x), float(y)) || refl_mean_above(st[l], a.stop_mean))  // early termination
+            alive[l] = false, --live;
         }
     };
     for_each_reaching_splat(a.bins, a.splats, bounds, tile, tp, [&] { return live > 0; }, splat_fwd);

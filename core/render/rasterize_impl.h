@@ -88,6 +88,7 @@ void refl_fwd(Backend b, ReflFwdArgs a) {
         const int32_t g = a.bins.values[k];
         if (a.mode == PlaneMode::Match && a.plane_ids[g] != I) continue;  // 1(l_i == I(u))
         if (!refl_step(st, a.splats[g], px, py)) break;                   // early termination
+        if (refl_mean_above(st, a.stop_mean)) break;                       // decided (stop_mean)
       }
     }
     a.C_r(x, y) = st.C;

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -182,7 +183,8 @@ void Renderer::render(const RenderCamera& camera, const GaussianSet& base, const
 }
 
 void Renderer::render_reflection(const RenderCamera& camera, const GaussianSet& reflection,
-                                 const DeviceImage<int32_t>& I, RenderOutputs& out) {
+                                 const DeviceImage<int32_t>& I, RenderOutputs& out, float stop_mean) {
+  if (std::isnan(stop_mean)) throw std::invalid_argument("Renderer::render_reflection: stop_mean is NaN");
   const Intrinsics& K = camera.K;
   if (!K.valid()) throw std::invalid_argument("Renderer: invalid intrinsics " + K.to_string());
   if (reflection.device() != device_)
@@ -195,11 +197,12 @@ void Renderer::render_reflection(const RenderCamera& camera, const GaussianSet& 
   const kernel::View vr = make_view(camera, reflection);
   timings_.reflection_ms = timed(params_.time_stages, device_, [&] {
     project(vr, reflection, refl_);
-    reflection_forward(vr, I, out);
+    reflection_forward(vr, I, out, stop_mean);
   });
 }
 
-void Renderer::reflection_forward(const kernel::View& view, const DeviceImage<int32_t>& I, RenderOutputs& out) {
+void Renderer::reflection_forward(const kernel::View& view, const DeviceImage<int32_t>& I, RenderOutputs& out,
+                                  float stop_mean) {
   const GaussianSet& set = *refl_set_;
   const int64_t n = int64_t(set.size());
   auto splats = first(refl_.splats, n);
@@ -209,7 +212,7 @@ void Renderer::reflection_forward(const kernel::View& view, const DeviceImage<in
     refl_entries_ = refl_.bins.entries();
     const auto mode = params_.variant == ReflectionVariant::Grouped ? kernel::PlaneMode::Match : kernel::PlaneMode::All;
     kernel::ReflFwdArgs a{view, splats, refl_.bins.views(), set.plane_ids(), I.view(), mode, 0,
-                          out.C_r.view(), out.W_r.view()};
+                          out.C_r.view(), out.W_r.view(), stop_mean};
     RRG_DISPATCH(device_, kernel::refl_fwd_cpu(a), kernel::refl_fwd_cuda(a));
     return;
   }
@@ -223,7 +226,7 @@ void Renderer::reflection_forward(const kernel::View& view, const DeviceImage<in
     refl_.bins.build(view, splats, rects, set.plane_ids(), k, true, device_);
     refl_entries_ += refl_.bins.entries();
     kernel::ReflFwdArgs a{view, splats, refl_.bins.views(), set.plane_ids(), I.view(), kernel::PlaneMode::All, k,
-                          group_C_.view(), group_W_.view()};
+                          group_C_.view(), group_W_.view(), stop_mean};
     RRG_DISPATCH(device_, kernel::refl_fwd_cpu(a), kernel::refl_fwd_cuda(a));
     RRG_DISPATCH(device_,
                  kernel::mask_group_cpu(I.view(), k, group_C_.view(), group_W_.view(), out.C_r.view(), out.W_r.view()),

@@ -15,6 +15,7 @@
 #include "core/render/splat.h"
 #include "core/render/tile_bins.h"
 
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -46,9 +47,12 @@ class Renderer {
 
   // Pass 3 alone: C_r and W_r of `reflection` over the plane-id map I (the other outputs are left
   // as they are). What the tracking mask needs, C_r at a pose, without pass 2 or the TSDF colour.
-  // backward() cannot follow it (it throws until the next render()).
+  // backward() cannot follow it (it throws until the next render()). With a finite stop_mean a
+  // pixel stops compositing once the mean RGB of its C_r exceeds stop_mean: C_r and W_r are exact
+  // where that mean stays <= stop_mean, and elsewhere partial sums whose mean is > stop_mean (C_r
+  // only grows along the list), which is all the mask's test mean > threshold needs.
   void render_reflection(const RenderCamera& camera, const GaussianSet& reflection, const DeviceImage<int32_t>& I,
-                         RenderOutputs& out);
+                         RenderOutputs& out, float stop_mean = std::numeric_limits<float>::infinity());
 
   // Gradients of every parameter of both sets (not the TSDF maps) for the last render(), given
   // dL/dC, dL/dD_b and optionally dL/dC_r. Writes `touched` of v_base and v_reflection, and their
@@ -70,7 +74,8 @@ class Renderer {
   };
   kernel::View make_view(const RenderCamera& camera, const GaussianSet& set) const;
   void project(const kernel::View& view, const GaussianSet& set, Projected& p);
-  void reflection_forward(const kernel::View& view, const DeviceImage<int32_t>& I, RenderOutputs& out);
+  void reflection_forward(const kernel::View& view, const DeviceImage<int32_t>& I, RenderOutputs& out,
+                          float stop_mean = std::numeric_limits<float>::infinity());
   void reflection_backward(const kernel::View& view, const DeviceImage<Color>& v_C_r);
   std::vector<int32_t> reflection_groups() const;
 

@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <limits>
 
 namespace rrg::kernel {
 
@@ -71,6 +72,8 @@ struct ReflFwdArgs {
   int32_t plane;                                // for PixelOnly
   ImageView<Eigen::Vector3f> C_r;
   ImageView<float> W_r;
+  // A pixel stops once the mean RGB of its C_r exceeds this (refl_mean_above); +inf: never.
+  float stop_mean = std::numeric_limits<float>::infinity();
 };
 
 struct ReflBwdArgs {

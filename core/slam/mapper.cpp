@@ -345,13 +345,14 @@ void GaussianMapper::render(const RenderCamera& cam, const RaycastResult& raycas
   query_renderer_.render(cam, snap->base, snap->reflection, in, out);
 }
 
-ColorImage GaussianMapper::render_reflection(const RenderCamera& cam, const DeviceImage<int32_t>& I) const {
+ColorImage GaussianMapper::render_reflection(const RenderCamera& cam, const DeviceImage<int32_t>& I,
+                                             float stop_mean) const {
   const auto snap = snapshot();
   if (params_.render.variant != ReflectionVariant::NoPlaneGrouping && !shows_any_plane(I.to_host(), snap->reflection_planes))
     return ColorImage(cam.K.width, cam.K.height, Color::Zero());  // what pass 3 would draw: nothing
   RenderOutputs out;
   std::lock_guard lock(render_mutex_);
-  query_renderer_.render_reflection(cam, snap->reflection, I, out);
+  query_renderer_.render_reflection(cam, snap->reflection, I, out, stop_mean);
   return out.C_r.to_host();
 }
 

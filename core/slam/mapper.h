@@ -32,6 +32,7 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <vector>
@@ -135,8 +136,10 @@ class GaussianMapper {
   // Thread-safe with step().
   void render(const RenderCamera& cam, const RaycastResult& raycast, RenderOutputs& out) const;
   // C_r alone (pass 3 of the latest snapshot's reflection set over plane-id map I), on the host.
-  // Thread-safe with step().
-  ColorImage render_reflection(const RenderCamera& cam, const DeviceImage<int32_t>& I) const;
+  // Thread-safe with step(). stop_mean: see Renderer::render_reflection (exact where the mean RGB
+  // stays <= stop_mean; the tracking mask passes its threshold).
+  ColorImage render_reflection(const RenderCamera& cam, const DeviceImage<int32_t>& I,
+                               float stop_mean = std::numeric_limits<float>::infinity()) const;
   GaussianHost base_host() const;
   GaussianHost reflection_host() const;
   // Replaces both sets (session load); optimiser state restarts. Publishes a snapshot.

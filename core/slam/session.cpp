@@ -136,12 +136,13 @@ RaycastResult Session::Impl::locked_raycast(const Intrinsics& K_, const Eigen::I
   return raycast(volume, K_, T_wc, ids, outputs);
 }
 
-// C_r at the ICP pose for the tracking mask (§4.1.2): pass 3 over the plane-id map only.
+// C_r at the ICP pose for the tracking mask (§4.1.2): pass 3 over the plane-id map only, each
+// pixel composited until the mask's test mean RGB > threshold is decided (the mask is the same).
 ColorImage Session::Impl::render_reflection(const Eigen::Isometry3f& T_wc) {
   const auto snap = mapper.snapshot();
   if (!snap || snap->reflection.size() == 0) return ColorImage(K.width, K.height, Color::Zero());
   const RaycastResult rc = locked_raycast(K, T_wc, RaycastOutputs{.color = false, .reflection = true, .normals = false});
-  return mapper.render_reflection(RenderCamera{K, T_wc}, rc.plane_ids);
+  return mapper.render_reflection(RenderCamera{K, T_wc}, rc.plane_ids, config.tracking.orb.mask_threshold);
 }
 
 MappingContext Session::Impl::mapping_context() {

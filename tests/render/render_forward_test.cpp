@@ -231,6 +231,51 @@ TEST(RenderForward, ReflectionPassAloneEqualsTheFullRendersCr) {
   }
 }
 
+// render_reflection with a stop threshold (the tracking mask's): where the full C_r's mean RGB is
+// <= the threshold, C_r and W_r are the full ones bit for bit; elsewhere the pixel stopped early with
+// a mean above it (the mask's test, mask_source.h, gives the same answer) and no channel above the
+// full one; and some
+// pixels did stop early (the scene's reflections are bright enough). Every variant, every device.
+TEST(RenderForward, ReflectionPassStoppedAtTheMaskThresholdGivesTheSameMask) {
+  const SmallScene s = small_scene(29, 96, 64);
+  // the mask's default threshold, and a lower one at which part of the bright pixels stop before the
+  // end of their lists (at 0.1 this small scene's pixels cross it at their last splats)
+  for (const float threshold : {0.1f, 0.02f})
+    for (const Device& device : available_devices())
+      for (const ReflectionVariant v : {ReflectionVariant::Grouped, ReflectionVariant::NoPlaneGrouping, ReflectionVariant::MultiPass}) {
+        SCOPED_TRACE(device.to_string() + " " + to_string(v) + " threshold " + std::to_string(threshold));
+        RenderParams p;
+        p.variant = v;
+        const auto r = GaussianSet::from_host(s.refl, device);
+        const auto rc = to_device(s.raycast, device);
+        Renderer renderer(device, p);
+        RenderOutputs full, stopped;
+        renderer.render_reflection(s.camera, r, rc.I, full);
+        renderer.render_reflection(s.camera, r, rc.I, stopped, threshold);
+        const ColorImage C = full.C_r.to_host(), C_s = stopped.C_r.to_host();
+        const DepthImage W = full.W_r.to_host(), W_s = stopped.W_r.to_host();
+        int above = 0, early = 0;
+        for (size_t i = 0; i < C.size(); ++i) {
+          if (!(C[i].sum() / 3.0f > threshold)) {
+            ASSERT_EQ(C_s[i], C[i]) << "pixel " << i;
+            ASSERT_EQ(W_s[i], W[i]) << "pixel " << i;
+            continue;
+          }
+          ++above;
+          ASSERT_GT(C_s[i].sum() / 3.0f, threshold) << "pixel " << i;
+          for (int c = 0; c < 3; ++c) ASSERT_LE(C_s[i][c], C[i][c] * (1.0f + 1e-6f) + 1e-7f) << "pixel " << i;
+          early += C_s[i] != C[i];
+        }
+        EXPECT_GT(above, 80);
+        if (threshold < 0.05f) EXPECT_GT(early, 20);  // the stop path ran
+      }
+  Renderer cpu(Device::cpu());
+  RenderOutputs out;
+  const auto r = GaussianSet::from_host(s.refl, Device::cpu());
+  const auto rc = to_device(s.raycast, Device::cpu());
+  EXPECT_THROW(cpu.render_reflection(s.camera, r, rc.I, out, std::nanf("")), std::invalid_argument);
+}
+
 TEST(RenderForward, TiledPipelineMatchesTheDoubleReference) {
   for (auto variant : {ReflectionVariant::Grouped, ReflectionVariant::NoPlaneGrouping}) {
     const SmallScene s = small_scene(41, 72, 40);
