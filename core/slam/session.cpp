@@ -103,7 +103,7 @@ Session::Impl::Impl(SessionConfig c, std::unique_ptr<SemanticCue> cue)
       mapper(config.mapping, K, config.device) {
   if (config.tracking.mode == TrackingMode::IcpOrbMask && !config.gt_poses)
     masks = std::make_unique<RenderedReflectionMasks>(
-        [this](size_t, const Eigen::Isometry3f& T_wc) { return render_reflection(T_wc); },
+        [this](size_t, const Eigen::Isometry3f& T_wc, float threshold) { return render_reflection(T_wc, threshold); },
         config.tracking.orb.mask_threshold);
 }
 
@@ -138,11 +138,11 @@ RaycastResult Session::Impl::locked_raycast(const Intrinsics& K_, const Eigen::I
 
 // C_r at the ICP pose for the tracking mask (§4.1.2): pass 3 over the plane-id map only, each
 // pixel composited until the mask's test mean RGB > threshold is decided (the mask is the same).
-ColorImage Session::Impl::render_reflection(const Eigen::Isometry3f& T_wc) {
+ColorImage Session::Impl::render_reflection(const Eigen::Isometry3f& T_wc, float stop_mean) {
   const auto snap = mapper.snapshot();
   if (!snap || snap->reflection.size() == 0) return ColorImage(K.width, K.height, Color::Zero());
   const RaycastResult rc = locked_raycast(K, T_wc, RaycastOutputs{.color = false, .reflection = true, .normals = false});
-  return mapper.render_reflection(RenderCamera{K, T_wc}, rc.plane_ids, config.tracking.orb.mask_threshold);
+  return mapper.render_reflection(RenderCamera{K, T_wc}, rc.plane_ids, stop_mean);
 }
 
 MappingContext Session::Impl::mapping_context() {

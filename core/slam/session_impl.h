@@ -71,7 +71,8 @@ struct Session::Impl {
   MappingContext mapping_context();
   RaycastResult locked_raycast(const Intrinsics& K, const Eigen::Isometry3f& T_wc,
                                RaycastOutputs outputs = RaycastOutputs::all()) const;
-  ColorImage render_reflection(const Eigen::Isometry3f& T_wc);  // C_r for the tracking mask
+  // C_r for the tracking mask, exact where its mean RGB stays <= stop_mean (the mask's threshold)
+  ColorImage render_reflection(const Eigen::Isometry3f& T_wc, float stop_mean);
   std::vector<int32_t> remap_copy() const {
     std::lock_guard lock(state_mutex);
     return remap;

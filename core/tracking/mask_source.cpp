@@ -14,7 +14,7 @@ MaskImage tracking_mask_from_reflection(const ColorImage& reflection_color, floa
 }
 
 MaskImage RenderedReflectionMasks::mask(size_t frame_index, const Eigen::Isometry3f& T_wc_icp) {
-  return tracking_mask_from_reflection(render_(frame_index, T_wc_icp), threshold_);
+  return tracking_mask_from_reflection(render_(frame_index, T_wc_icp, threshold_), threshold_);
 }
 
 SynthReflectionMasks::SynthReflectionMasks(std::filesystem::path root) : root_(std::move(root)) {

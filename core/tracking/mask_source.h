@@ -21,10 +21,13 @@ class MaskSource {
 // R^track(u) = (C_r,r + C_r,g + C_r,b) / 3 > threshold.
 MaskImage tracking_mask_from_reflection(const ColorImage& reflection_color, float threshold = 0.1f);
 
-// Renders C_r with a callback (the reflection Gaussians, later) and thresholds it.
+// Renders C_r with a callback (the reflection Gaussians) and thresholds it. The callback gets the
+// threshold: C_r only needs to be exact where its mean RGB stays at or below it (a renderer may stop
+// a pixel once it is above, Renderer::render_reflection's stop_mean), so the stop and the test are
+// one value.
 class RenderedReflectionMasks final : public MaskSource {
  public:
-  using Renderer = std::function<ColorImage(size_t frame_index, const Eigen::Isometry3f& T_wc)>;
+  using Renderer = std::function<ColorImage(size_t frame_index, const Eigen::Isometry3f& T_wc, float threshold)>;
   RenderedReflectionMasks(Renderer render, float threshold) : render_(std::move(render)), threshold_(threshold) {}
   MaskImage mask(size_t frame_index, const Eigen::Isometry3f& T_wc_icp) override;
 

@@ -109,8 +109,10 @@ TEST(MaskSource, TrackingMaskThresholdsMeanReflectionColour) {
   EXPECT_EQ(m(0, 0), 0);
   EXPECT_EQ(m(1, 0), 1);
   EXPECT_EQ(m(2, 0), 0);
-  RenderedReflectionMasks source([&](size_t, const Eigen::Isometry3f&) { return c; }, 0.05f);
+  float passed = -1.0f;  // the render callback gets the mask's threshold (its stop, mask_source.h)
+  RenderedReflectionMasks source([&](size_t, const Eigen::Isometry3f&, float t) { passed = t; return c; }, 0.05f);
   EXPECT_EQ(source.mask(0, Eigen::Isometry3f::Identity())(0, 0), 1);
+  EXPECT_EQ(passed, 0.05f);
   EXPECT_THROW(SynthReflectionMasks("/nonexistent/folder"), std::runtime_error);
 }
 
