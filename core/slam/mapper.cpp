@@ -318,9 +318,10 @@ MappingStats GaussianMapper::step(const MappingContext& ctx) {
   publish();
   st.ms_total = ms_since(t_start);
   spdlog::debug("mapping step {}: {} frames, +{} / -{} base ({}), +{} / -{} reflection ({}; pass 3 skipped in {} of {} "
-                "iterations), loss {:.4f}, {:.1f} ms",
+                "iterations), loss {:.4f}, {:.1f} ms (raycast {:.1f}, densify {:.1f}, optimise {:.1f}, prune {:.1f})",
                 steps_, st.frames, st.base_added, st.base_pruned, st.base_size, st.reflection_added,
-                st.reflection_pruned, st.reflection_size, st.reflection_skipped, st.iterations, st.loss, st.ms_total);
+                st.reflection_pruned, st.reflection_size, st.reflection_skipped, st.iterations, st.loss, st.ms_total,
+                st.ms_raycast, st.ms_densify, st.ms_optimise, st.ms_prune);
   return st;
 }
 
