@@ -4,12 +4,18 @@
 // takes a whole 16 x 16 tile and walks the tile's splats in list order, visiting for each splat only
 // the pixels of the tile it can reach (splat_pixel_bounds). Every pixel therefore sees the same
 // splats in the same order as in the per-pixel loop (forward results are the same), pixels a splat
-// cannot reach cost nothing, and a splat's gradient is summed over the tile locally and added to
-// the shared one once per (tile, splat) instead of once per (pixel, splat).
+// cannot reach cost nothing, and a splat's gradient is summed over the tile locally, once per
+// (tile, splat) entry instead of once per (pixel, splat). The backward then adds the entries into
+// the splats in entry order (sum_entries), not with atomics in whatever order threads finish their
+// tiles: the gradients, and so the maps of `--sync` runs, are the same bit for bit whatever the
+// number of threads.
 #include "core/common/parallel_for.h"
 #include "core/render/rasterize_impl.h"
 
+#include <omp.h>
+
 #include <algorithm>
+#include <cstring>
 #include <vector>
 
 namespace rrg::kernel {
@@ -49,8 +55,8 @@ bool reach(const TilePixels& splat, const TilePixels& t, TilePixels& out) {
   return out.x0 < out.x1 && out.y0 < out.y1;
 }
 
-// f(g, splat, pixels) for every splat of the tile's list, in list order, that reaches the tile;
-// pixels is the part of the tile within its reach. Stops early when more() turns false.
+// f(k, g, splat, pixels) for every entry k of the tile's list, in list order, whose splat g reaches
+// the tile; pixels is the part of the tile within its reach. Stops early when more() turns false.
 template <class More, class F>
 void for_each_reaching_splat(const BinViews& bins, Span<const Splat> splats, const std::vector<TilePixels>& bounds,
                              int tile, const TilePixels& tp, More more, F f) {
@@ -58,7 +64,34 @@ void for_each_reaching_splat(const BinViews& bins, Span<const Splat> splats, con
   for (int32_t k = r.begin; k < r.end && more(); ++k) {
     const int32_t g = bins.values[k];
     TilePixels p;
-    if (reach(bounds[size_t(g)], tp, p)) f(g, splats[g], p);
+    if (reach(bounds[size_t(g)], tp, p)) f(k, g, splats[g], p);
+  }
+}
+
+// The tile's entries set to zero: an entry whose splat misses the tile, or that an early stop never
+// reaches, holds no gradient (the scratch keeps an earlier pass's values otherwise).
+void clear_entries(const BinViews& bins, int tile, Span<SplatGrad> entries) {
+  const TileRange r = bins.ranges[tile];
+  if (r.end > r.begin) std::memset(&entries[r.begin], 0, size_t(r.end - r.begin) * sizeof(SplatGrad));
+}
+
+// v_splats[g] += the entries k of splat g (values[k] == g), in increasing k. Each thread owns a
+// contiguous range of splats and scans every entry, so each splat's sum has one order whatever the
+// number of threads.
+void sum_entries(const BinViews& bins, Span<const SplatGrad> entries, Span<SplatGrad> v_splats) {
+  const int64_t n = v_splats.size, m = bins.values.size;
+  constexpr int kFields = int(sizeof(SplatGrad) / sizeof(float));
+#pragma omp parallel
+  {
+    const int64_t parts = omp_get_num_threads(), part = omp_get_thread_num();
+    const int64_t g0 = n * part / parts, g1 = n * (part + 1) / parts;
+    for (int64_t k = 0; k < m; ++k) {
+      const int32_t g = bins.values[k];
+      if (g < g0 || g >= g1 || is_zero(entries[k])) continue;
+      float* d = &v_splats[g].mean[0];
+      const float* e = &entries[k].mean[0];
+      for (int f = 0; f < kFields; ++f) d[f] += e[f];
+    }
   }
 }
 
@@ -80,7 +113,7 @@ void base_fwd_cpu(BaseFwdArgs a) {
     float D_t[kTilePixels];
     for (int y = tp.y0; y < tp.y1; ++y)
       for (int x = tp.x0; x < tp.x1; ++x) D_t[tp.local(x, y)] = a.D_t(x, y);
-    const auto splat_fwd = [&](int32_t, const Splat& s, const TilePixels& p) {
+    const auto splat_fwd = [&](int32_t, int32_t, const Splat& s, const TilePixels& p) {
       for (int y = p.y0; y < p.y1; ++y)
         for (int x = p.x0; x < p.x1; ++x) {
           const int l = tp.local(x, y);
@@ -103,9 +136,10 @@ void base_fwd_cpu(BaseFwdArgs a) {
   });
 }
 
-void base_bwd_cpu(BaseBwdArgs a) {
+void base_bwd_cpu(BaseBwdArgs a, Span<SplatGrad> entries) {
   const std::vector<TilePixels> bounds = splat_reach(a.splats);
   for_each_tile(a.view, [&](int tile) {
+    clear_entries(a.bins, tile, entries);
     const TilePixels tp = tile_pixels(a.view, tile);
     BaseUpstreamT<float> up[kTilePixels];
     float D_t[kTilePixels];
@@ -122,17 +156,18 @@ void base_bwd_cpu(BaseBwdArgs a) {
         up[l] = base_resolve_bwd(a.W_g(x, y), D_t[l], Vec3<float>(a.C_b(x, y)), a.D_b(x, y), v_C_b, v_D_b);
       }
     if (!any) return;
-    const auto splat_bwd = [&](int32_t g, const Splat& s, const TilePixels& p) {
+    const auto splat_bwd = [&](int32_t k, int32_t, const Splat& s, const TilePixels& p) {
       SplatGrad v{};
       for (int y = p.y0; y < p.y1; ++y)
         for (int x = p.x0; x < p.x1; ++x) {
           const int l = tp.local(x, y);
           if (active[l]) base_splat_bwd(s, float(x), float(y), D_t[l], a.eps, up[l], v);
         }
-      if (!is_zero(v)) accumulate_grad(CpuBackend{}, &a.v_splats[g], v);
+      entries[k] = v;
     };
     for_each_reaching_splat(a.bins, a.splats, bounds, tile, tp, [] { return true; }, splat_bwd);
   });
+  sum_entries(a.bins, entries, a.v_splats);
 }
 
 void refl_fwd_cpu(ReflFwdArgs a) {
@@ -150,7 +185,7 @@ void refl_fwd_cpu(ReflFwdArgs a) {
         alive[l] = refl_pixel_active(a.mode, a.plane, I[l]);
         live += alive[l] ? 1 : 0;
       }
-    const auto splat_fwd = [&](int32_t g, const Splat& s, const TilePixels& p) {
+    const auto splat_fwd = [&](int32_t, int32_t g, const Splat& s, const TilePixels& p) {
       for (int y = p.y0; y < p.y1; ++y)
         for (int x = p.x0; x < p.x1; ++x) {
           const int l = tp.local(x, y);
@@ -169,9 +204,10 @@ void refl_fwd_cpu(ReflFwdArgs a) {
   });
 }
 
-void refl_bwd_cpu(ReflBwdArgs a) {
+void refl_bwd_cpu(ReflBwdArgs a, Span<SplatGrad> entries) {
   const std::vector<TilePixels> bounds = splat_reach(a.splats);
   for_each_tile(a.view, [&](int tile) {
+    clear_entries(a.bins, tile, entries);
     const TilePixels tp = tile_pixels(a.view, tile);
     ReflStateT<float> st[kTilePixels];
     Vec3<float> v_C[kTilePixels], C_final[kTilePixels];
@@ -191,7 +227,7 @@ void refl_bwd_cpu(ReflBwdArgs a) {
         alive[l] = true;
         ++live;
       }
-    const auto splat_bwd = [&](int32_t g, const Splat& s, const TilePixels& p) {
+    const auto splat_bwd = [&](int32_t k, int32_t g, const Splat& s, const TilePixels& p) {
       SplatGrad v{};
       for (int y = p.y0; y < p.y1; ++y)
         for (int x = p.x0; x < p.x1; ++x) {
@@ -200,10 +236,11 @@ void refl_bwd_cpu(ReflBwdArgs a) {
           if (!refl_step_bwd(st[l], s, float(x), float(y), C_final[l], W_final[l], v_C[l], 0.0f, v))
             alive[l] = false, --live;
         }
-      if (!is_zero(v)) accumulate_grad(CpuBackend{}, &a.v_splats[g], v);
+      entries[k] = v;
     };
     for_each_reaching_splat(a.bins, a.splats, bounds, tile, tp, [&] { return live > 0; }, splat_bwd);
   });
+  sum_entries(a.bins, entries, a.v_splats);
 }
 
 void composite_cpu(ImageView<const Eigen::Vector3f> C_b, ImageView<const float> R,

@@ -17,8 +17,9 @@ inline int64_t tile_slots(const View& v) { return int64_t(v.tiles_x()) * v.tiles
 }  // namespace rrg::kernel
 
 namespace rrg {
-// Adds a pixel's splat gradient into the shared one. CPU: plain atomics (few threads, rarely
-// contended). The CUDA overload (grad_accumulate.cuh) first sums the lanes of a warp that hold the
+// Adds a pixel's splat gradient into the shared one. CPU: plain atomics, for the per-pixel loops
+// below that the tests run on the CPU as the reference (the CPU back end's tile schedule sums the
+// tiles' entries in a fixed order instead, rasterize_cpu.cpp). The CUDA overload (grad_accumulate.cuh) first sums the lanes of a warp that hold the
 // same Gaussian, then does one atomic per field. Found by argument-dependent lookup on the tag.
 RRG_HD inline void accumulate_grad(CpuBackend, kernel::SplatGrad* dst, const kernel::SplatGrad& g) {
   kernel::atomic_add_grad(dst, g);
@@ -152,11 +153,14 @@ void mask_group(Backend b, ImageView<const int32_t> I, int32_t plane, ImageView<
 
 void base_fwd_cpu(BaseFwdArgs a);
 void base_fwd_cuda(BaseFwdArgs a);
-void base_bwd_cpu(BaseBwdArgs a);
+// The CPU backward passes take a scratch of at least a.bins.values.size entries: each (tile, splat)
+// entry's gradient, summed over the tile, before they are added into a.v_splats in entry order
+// (rasterize_cpu.cpp; the result does not depend on the number of threads).
+void base_bwd_cpu(BaseBwdArgs a, Span<SplatGrad> entries);
 void base_bwd_cuda(BaseBwdArgs a);
 void refl_fwd_cpu(ReflFwdArgs a);
 void refl_fwd_cuda(ReflFwdArgs a);
-void refl_bwd_cpu(ReflBwdArgs a);
+void refl_bwd_cpu(ReflBwdArgs a, Span<SplatGrad> entries);
 void refl_bwd_cuda(ReflBwdArgs a);
 void composite_cpu(ImageView<const Eigen::Vector3f> C_b, ImageView<const float> R, ImageView<const Eigen::Vector3f> C_r, ImageView<Eigen::Vector3f> C);
 void composite_cuda(ImageView<const Eigen::Vector3f> C_b, ImageView<const float> R, ImageView<const Eigen::Vector3f> C_r, ImageView<Eigen::Vector3f> C);

@@ -70,8 +70,10 @@ class Renderer {
     Buffer<kernel::Splat> splats;
     Buffer<kernel::TileRect> rects;
     Buffer<kernel::SplatGrad> v_splats;
+    Buffer<kernel::SplatGrad> entry_grads;  // CPU backward: one per bin entry (rasterize_impl.h)
     TileBins bins;
   };
+  Span<kernel::SplatGrad> entry_scratch(Projected& p);
   kernel::View make_view(const RenderCamera& camera, const GaussianSet& set) const;
   void project(const kernel::View& view, const GaussianSet& set, Projected& p);
   void reflection_forward(const kernel::View& view, const DeviceImage<int32_t>& I, RenderOutputs& out,

@@ -59,7 +59,7 @@ struct BaseBwdArgs {
   ImageView<const Eigen::Vector3f> C_b;
   ImageView<const Eigen::Vector3f> v_C_b;
   ImageView<const float> v_D_b;
-  Span<SplatGrad> v_splats;                     // [N], accumulated atomically
+  Span<SplatGrad> v_splats;                     // [N], accumulated (CUDA: atomically)
 };
 
 struct ReflFwdArgs {

@@ -2,14 +2,17 @@
 // can reach (rasterize_cpu.cpp); CUDA runs them pixel by pixel (rasterize_impl.h). These tests run
 // the per-pixel template on the CPU as the reference and require the same images and gradients,
 // on splats chosen to stress the reach bound: thin and rotated ellipses, huge ones, opacities around
-// the 1/255 cut, splats centred off the image and off their tiles.
+// the 1/255 cut, splats centred off the image and off their tiles. The CPU backward's gradients
+// must also not depend on the number of threads (it sums the tiles' entries in a fixed order).
 #include "core/common/parallel_for.h"
 #include "core/render/rasterize_impl.h"
 
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <vector>
 
@@ -91,6 +94,19 @@ ImageView<const T> cimg(const std::vector<T>& v, const Scene& sc) {
 }
 template <class T>
 Span<const T> cspan(const std::vector<T>& v) {
+  return {v.data(), int64_t(v.size())};
+}
+
+// The CPU backward's entry scratch for a scene, filled with NaN: every entry a pass reads must be
+// one it wrote in that pass.
+std::vector<SplatGrad> entry_scratch(const Scene& sc) {
+  SplatGrad nan{};
+  float* f = &nan.mean[0];
+  for (int k = 0; k < int(sizeof(SplatGrad) / sizeof(float)); ++k) f[k] = std::nanf("");
+  return std::vector<SplatGrad>(sc.values.size(), nan);
+}
+template <class T>
+Span<T> span(std::vector<T>& v) {
   return {v.data(), int64_t(v.size())};
 }
 
@@ -193,7 +209,8 @@ TEST(RasterizeSchedule, BasePassMatchesThePerPixelLoop) {
   b.v_D_b = cimg(sc.v_D, sc);
   std::vector<SplatGrad> g_tiled(sc.splats.size(), SplatGrad{}), g_pixel(sc.splats.size(), SplatGrad{});
   b.v_splats = {g_tiled.data(), int64_t(g_tiled.size())};
-  base_bwd_cpu(b);
+  std::vector<SplatGrad> scratch = entry_scratch(sc);
+  base_bwd_cpu(b, span(scratch));
   b.v_splats = {g_pixel.data(), int64_t(g_pixel.size())};
   base_bwd(CpuBackend{}, b);
   int nonzero = 0;
@@ -250,7 +267,8 @@ TEST_P(ReflSchedule, ReflectionPassMatchesThePerPixelLoop) {
   b.v_C_r = cimg(sc.v_C, sc);
   std::vector<SplatGrad> g_tiled(sc.splats.size(), SplatGrad{}), g_pixel(sc.splats.size(), SplatGrad{});
   b.v_splats = {g_tiled.data(), int64_t(g_tiled.size())};
-  refl_bwd_cpu(b);
+  std::vector<SplatGrad> scratch = entry_scratch(sc);
+  refl_bwd_cpu(b, span(scratch));
   b.v_splats = {g_pixel.data(), int64_t(g_pixel.size())};
   refl_bwd(CpuBackend{}, b);
   int nonzero = 0;
@@ -263,6 +281,89 @@ TEST_P(ReflSchedule, ReflectionPassMatchesThePerPixelLoop) {
 
 INSTANTIATE_TEST_SUITE_P(Modes, ReflSchedule,
                          ::testing::Values(PlaneMode::Match, PlaneMode::All, PlaneMode::PixelOnly));
+
+// Sets the OpenMP thread count while in scope.
+struct Threads {
+  int saved = omp_get_max_threads();
+  explicit Threads(int n) { omp_set_num_threads(n); }
+  ~Threads() { omp_set_num_threads(saved); }
+};
+
+bool bitwise_equal(const std::vector<SplatGrad>& a, const std::vector<SplatGrad>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(SplatGrad)) == 0;
+}
+
+// Both backward passes, on one thread and repeatedly on several: the same gradients bit for bit.
+// (With atomic adds per (tile, splat), as before, the sums' order followed the threads' progress
+// and the last bits differed between runs.) Many splats reach many tiles here, so each splat's
+// gradient is a sum over several tiles' entries.
+TEST(RasterizeSchedule, BackwardGradientsDoNotDependOnTheThreadCount) {
+  Scene sc = make_scene(5, 300);
+  for (const TileRange& r : sc.ranges)  // pass 3 composites front to back
+    std::stable_sort(sc.values.begin() + r.begin, sc.values.begin() + r.end,
+                     [&](int32_t p, int32_t q) { return sc.splats[size_t(p)].depth < sc.splats[size_t(q)].depth; });
+  const size_t n = sc.C_t.size();
+  BaseOut fwd(n);
+  base_fwd_cpu(base_fwd_args(sc, fwd));
+  std::vector<Eigen::Vector3f> C_r(n);
+  std::vector<float> W_r(n);
+  ReflFwdArgs rf{};
+  rf.view = sc.view;
+  rf.splats = cspan(sc.splats);
+  rf.bins = {cspan(sc.values), cspan(sc.ranges)};
+  rf.plane_ids = cspan(sc.plane_ids);
+  rf.I = cimg(sc.I, sc);
+  rf.mode = PlaneMode::Match;
+  rf.C_r = img(C_r, sc);
+  rf.W_r = img(W_r, sc);
+  refl_fwd_cpu(rf);
+
+  const auto backward = [&] {
+    std::vector<SplatGrad> base(sc.splats.size(), SplatGrad{}), refl(sc.splats.size(), SplatGrad{});
+    std::vector<SplatGrad> scratch = entry_scratch(sc);
+    BaseBwdArgs b{};
+    b.view = sc.view;
+    b.eps = 0.05f;
+    b.splats = cspan(sc.splats);
+    b.bins = {cspan(sc.values), cspan(sc.ranges)};
+    b.D_t = cimg(sc.D_t, sc);
+    b.W_g = cimg(fwd.W_g, sc);
+    b.D_b = cimg(fwd.D_b, sc);
+    b.C_b = cimg(fwd.C_b, sc);
+    b.v_C_b = cimg(sc.v_C, sc);
+    b.v_D_b = cimg(sc.v_D, sc);
+    b.v_splats = span(base);
+    base_bwd_cpu(b, span(scratch));
+    ReflBwdArgs r{};
+    r.view = sc.view;
+    r.splats = cspan(sc.splats);
+    r.bins = {cspan(sc.values), cspan(sc.ranges)};
+    r.plane_ids = cspan(sc.plane_ids);
+    r.I = cimg(sc.I, sc);
+    r.mode = PlaneMode::Match;
+    r.C_r = cimg(C_r, sc);
+    r.W_r = cimg(W_r, sc);
+    r.v_C_r = cimg(sc.v_C, sc);
+    r.v_splats = span(refl);
+    refl_bwd_cpu(r, span(scratch));  // the same scratch again: it must not carry pass 2's entries
+    return std::pair{base, refl};
+  };
+  std::pair<std::vector<SplatGrad>, std::vector<SplatGrad>> one;
+  {
+    const Threads t(1);
+    one = backward();
+  }
+  int nonzero = 0;
+  for (const SplatGrad& g : one.first) nonzero += is_zero(g) ? 0 : 1;
+  EXPECT_GT(nonzero, 200);
+  for (const int threads : {2, 3, 4})
+    for (int rep = 0; rep < 4; ++rep) {
+      const Threads t(threads);
+      const auto many = backward();
+      EXPECT_TRUE(bitwise_equal(many.first, one.first)) << threads << " threads, run " << rep << " (pass 2)";
+      EXPECT_TRUE(bitwise_equal(many.second, one.second)) << threads << " threads, run " << rep << " (pass 3)";
+    }
+}
 
 }  // namespace
 }  // namespace rrg::kernel

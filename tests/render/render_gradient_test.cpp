@@ -249,16 +249,19 @@ TEST(RenderGradient, TouchedMarksExactlyTheGaussiansWithAGradient) {
         for (size_t k = 0; k < K; ++k) nonzero = nonzero || !h.sh[i * K + k].isZero(0.0f);
         EXPECT_EQ(touched[i] != 0, nonzero) << i;
         marked += touched[i];
-        // marked: written, the same values; unmarked: left as they were
-        const auto expected = [&](auto x) {
-          if (!touched[i]) x.setConstant(kSentinel);
-          return x;
+        // marked: written, the same values (bit for bit on the CPU, whose backward sums in a fixed
+        // order; CUDA's atomics sum in run-dependent order); unmarked: left as they were, exactly
+        const float rel = device.is_cpu() ? 0.0f : 1e-5f;
+        const auto same = [&](const auto& got, const auto& want) {
+          if (!touched[i]) return (got.array() == kSentinel).all();
+          return ((got - want).array().abs() <= rel * (1e-1f + want.array().abs())).all();
         };
-        EXPECT_EQ(hs.means[i], expected(h.means[i])) << i;
-        EXPECT_EQ(hs.log_scales[i], expected(h.log_scales[i])) << i;
-        EXPECT_EQ(hs.quats[i], expected(h.quats[i])) << i;
-        EXPECT_EQ(hs.logit_opacities[i], touched[i] ? h.logit_opacities[i] : kSentinel) << i;
-        for (size_t k = 0; k < K; ++k) EXPECT_EQ(hs.sh[i * K + k], expected(h.sh[i * K + k])) << i << " sh " << k;
+        EXPECT_TRUE(same(hs.means[i], h.means[i])) << i;
+        EXPECT_TRUE(same(hs.log_scales[i], h.log_scales[i])) << i;
+        EXPECT_TRUE(same(hs.quats[i], h.quats[i])) << i;
+        EXPECT_TRUE(same(Eigen::Matrix<float, 1, 1>(hs.logit_opacities[i]), Eigen::Matrix<float, 1, 1>(h.logit_opacities[i])))
+            << i;
+        for (size_t k = 0; k < K; ++k) EXPECT_TRUE(same(hs.sh[i * K + k], h.sh[i * K + k])) << i << " sh " << k;
       }
       EXPECT_GT(marked, 0u);
       EXPECT_LT(marked, h.size());

@@ -1,12 +1,11 @@
 // Session snapshots continue exactly: run N frames, save, load into a new session, run the rest;
-// the result must be the uninterrupted session's, bit for bit (sync mode, one CPU thread: the
-// renderer's CPU backward adds gradients with atomics, see SyncModeIsDeterministic). Also: a v1
-// file (no continuation section) still loads and continues from the last pose.
+// the result must be the uninterrupted session's, bit for bit (sync mode; on the CPU with any
+// number of threads, see SyncModeIsDeterministic). Also: a v1 file (no continuation section) still
+// loads and continues from the last pose.
 #include "core/tsdf/tsdf_io.h"
 #include "tests/slam/session_fixture.h"
 
 #include <gtest/gtest.h>
-#include <omp.h>
 #include <spdlog/spdlog.h>
 
 #include <cstring>
@@ -38,13 +37,6 @@ class SnapshotTest : public test::SynthSessionTest<SnapshotTest, kFrames> {
   static void run(Session& s, const io::Dataset& d, size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) s.process(frame(d, i));
   }
-};
-
-// One OpenMP thread while in scope (bitwise identical maps, see the file comment).
-struct OneThread {
-  int threads = omp_get_max_threads();
-  OneThread() { omp_set_num_threads(1); }
-  ~OneThread() { omp_set_num_threads(threads); }
 };
 
 void expect_same_gaussians(const GaussianHost& a, const GaussianHost& b, const char* set) {
@@ -90,7 +82,6 @@ void write_as_v1(const std::filesystem::path& v2, const std::filesystem::path& v
 }
 
 TEST_F(SnapshotTest, ALoadedSessionContinuesLikeTheUninterruptedOne) {
-  const OneThread one_thread;
   const auto d = io::open_dataset(root());
   test::TempDir dir("snap-continue");
   Session whole(config(*d));
