@@ -60,7 +60,8 @@ RRG_HD inline void ssim_window_sum(const T* src, int64_t p, int w, int h, bool v
   const int64_t step = vertical ? w : 1;
   for (int ch = 0; ch < 3; ++ch)
     for (int m = 0; m < M; ++m) s[ch][m] = T(0);
-  for (int k = k0; k <= k1; ++k) {
+  for (int k = -R; k <= R; ++k) {
+    if (k < k0 || k > k1) continue;
     const int64_t j = (p + k * step) * 3;
     const T g = win.g[k + R];
     for (int ch = 0; ch < 3; ++ch)
@@ -88,7 +89,8 @@ T ssim(Backend be, int w, int h, Span<const T> x, Span<const T> y, Span<T> v_x, 
     const int px = int(p % w), py = int(p / w);
     const int k0 = px - R < 0 ? -px : -R, k1 = px + R >= w ? w - 1 - px : R;
     T s[3][5] = {};
-    for (int k = k0; k <= k1; ++k) {
+    for (int k = -R; k <= R; ++k) {
+      if (k < k0 || k > k1) continue;
       const int64_t j = (int64_t(py) * w + px + k) * 3;
       const T g = win.g[k + R];
       for (int ch = 0; ch < 3; ++ch) {
