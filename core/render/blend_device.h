@@ -107,15 +107,29 @@ RRG_HD inline bool base_visible(const SplatT<T>& s, T D_t, T eps) {
   return !(D_t > T(0)) || s.depth < D_t + eps;
 }
 
-// Adds splat s at pixel (px, py); returns its alpha (0 when culled or negligible).
+// Adds splat s with its (non-zero) alpha at a pixel.
 template <class T>
-RRG_HD inline T base_accumulate(BaseAccumT<T>& acc, const SplatT<T>& s, T px, T py, T D_t, T eps) {
-  if (!base_visible(s, D_t, eps)) return T(0);
-  const T alpha = splat_alpha(s, px, py, T(1));
-  if (alpha == T(0)) return T(0);
+RRG_HD inline void base_add(BaseAccumT<T>& acc, const SplatT<T>& s, T alpha) {
   acc.C_g += alpha * Vec3<T>(s.color[0], s.color[1], s.color[2]);
   acc.W_g += alpha;
   acc.D_g += alpha * s.depth;
+}
+
+// The falloff of splat s at pixel (px, py) where it adds to pass 2, and its alpha; alpha = 0 when
+// it adds nothing there (depth cull, outside its ellipse, alpha below kAlphaMin).
+template <class T>
+RRG_HD inline T base_falloff(const SplatT<T>& s, T px, T py, T D_t, T eps, SplatFalloffT<T>& f) {
+  if (!base_visible(s, D_t, eps)) return T(0);
+  f = splat_falloff(s, px, py);
+  return splat_alpha(s, f, T(1));
+}
+
+// Adds splat s at pixel (px, py); returns its alpha (0 when culled or negligible).
+template <class T>
+RRG_HD inline T base_accumulate(BaseAccumT<T>& acc, const SplatT<T>& s, T px, T py, T D_t, T eps) {
+  SplatFalloffT<T> f{};
+  const T alpha = base_falloff(s, px, py, D_t, eps, f);
+  if (alpha != T(0)) base_add(acc, s, alpha);
   return alpha;
 }
 
@@ -155,19 +169,24 @@ RRG_HD inline BaseUpstreamT<T> base_resolve_bwd(T W_g, T D_t, const Vec3<T>& C_b
   return u;
 }
 
-// Gradient of splat s's contribution at (px, py) into v.
+// Gradient into v of splat s's contribution alpha (non-zero) with falloff f at a pixel.
 template <class T>
-RRG_HD inline void base_splat_bwd(const SplatT<T>& s, T px, T py, T D_t, T eps, const BaseUpstreamT<T>& u,
+RRG_HD inline void base_splat_bwd(const SplatT<T>& s, const SplatFalloffT<T>& f, T alpha, const BaseUpstreamT<T>& u,
                                   SplatT<T>& v) {
-  if (!base_visible(s, D_t, eps)) return;
-  const SplatFalloffT<T> f = splat_falloff(s, px, py);
-  const T alpha = splat_alpha(s, f, T(1));
-  if (alpha == T(0)) return;
   const Vec3<T> c(s.color[0], s.color[1], s.color[2]);
   const T v_alpha = u.v_C_g.dot(c) + u.v_W_g + u.v_D_g * s.depth;
   for (int ch = 0; ch < 3; ++ch) v.color[ch] += alpha * u.v_C_g[ch];
   v.depth += alpha * u.v_D_g;
   splat_alpha_bwd(s, f, T(1), v_alpha, v);
+}
+
+// Gradient of splat s's contribution at (px, py) into v.
+template <class T>
+RRG_HD inline void base_splat_bwd(const SplatT<T>& s, T px, T py, T D_t, T eps, const BaseUpstreamT<T>& u,
+                                  SplatT<T>& v) {
+  SplatFalloffT<T> f{};
+  const T alpha = base_falloff(s, px, py, D_t, eps, f);
+  if (alpha != T(0)) base_splat_bwd(s, f, alpha, u, v);
 }
 
 // ---- pass 3: A_r[x](u) = sum_i prod_{j<i} (1 - alpha_j) alpha_i x_i, alpha with 1(l_i == I(u)) ------

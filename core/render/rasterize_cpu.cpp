@@ -8,7 +8,8 @@
 // (tile, splat) entry instead of once per (pixel, splat). The backward then adds the entries into
 // the splats in entry order (sum_entries), not with atomics in whatever order threads finish their
 // tiles: the gradients, and so the maps of `--sync` runs, are the same bit for bit whatever the
-// number of threads.
+// number of threads. Pass 2's forward keeps the falloff of every pair it visits (CpuRasterScratch),
+// and its backward reads them instead of evaluating the exponential again.
 #include "core/common/parallel_for.h"
 #include "core/render/rasterize_impl.h"
 
@@ -16,6 +17,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <stdexcept>
 #include <vector>
 
 namespace rrg::kernel {
@@ -26,31 +28,29 @@ constexpr int kTilePixels = kTileSize * kTileSize;
 
 // A tile's pixels [x0, x1) x [y0, y1), clipped to the image; pixel (x, y) is at local index
 // (y - y0) * kTileSize + (x - x0).
-struct TilePixels {
-  int x0, y0, x1, y1;
+struct TilePixels : PixelRect {
   int local(int x, int y) const { return (y - y0) * kTileSize + (x - x0); }
 };
 
 TilePixels tile_pixels(const View& v, int tile) {
   const int x0 = (tile % v.tiles_x()) * kTileSize, y0 = (tile / v.tiles_x()) * kTileSize;
-  return {x0, y0, std::min(x0 + kTileSize, v.width), std::min(y0 + kTileSize, v.height)};
+  return {{x0, y0, std::min(x0 + kTileSize, v.width), std::min(y0 + kTileSize, v.height)}};
 }
 
 // Every splat's reachable pixels [x0, x1) x [y0, y1) (splat_pixel_bounds), computed once per pass
 // rather than once per (tile, splat) entry; empty (x0 = x1) when it reaches none.
-std::vector<TilePixels> splat_reach(Span<const Splat> splats) {
-  std::vector<TilePixels> out(size_t(splats.size));
+void splat_reach(Span<const Splat> splats, std::vector<PixelRect>& out) {
+  out.resize(size_t(splats.size));
 #pragma omp parallel for schedule(static)
   for (int64_t g = 0; g < splats.size; ++g) {
     int x0, y0, x1, y1;
-    out[size_t(g)] = splat_pixel_bounds(splats[g], x0, y0, x1, y1) ? TilePixels{x0, y0, x1 + 1, y1 + 1}
-                                                                    : TilePixels{0, 0, 0, 0};
+    out[size_t(g)] = splat_pixel_bounds(splats[g], x0, y0, x1, y1) ? PixelRect{x0, y0, x1 + 1, y1 + 1}
+                                                                    : PixelRect{0, 0, 0, 0};
   }
-  return out;
 }
 
 // The pixels of tile t within a splat's reach; false when none.
-bool reach(const TilePixels& splat, const TilePixels& t, TilePixels& out) {
+bool reach(const PixelRect& splat, const TilePixels& t, PixelRect& out) {
   out = {std::max(splat.x0, t.x0), std::max(splat.y0, t.y0), std::min(splat.x1, t.x1), std::min(splat.y1, t.y1)};
   return out.x0 < out.x1 && out.y0 < out.y1;
 }
@@ -58,27 +58,46 @@ bool reach(const TilePixels& splat, const TilePixels& t, TilePixels& out) {
 // f(k, g, splat, pixels) for every entry k of the tile's list, in list order, whose splat g reaches
 // the tile; pixels is the part of the tile within its reach. Stops early when more() turns false.
 template <class More, class F>
-void for_each_reaching_splat(const BinViews& bins, Span<const Splat> splats, const std::vector<TilePixels>& bounds,
+void for_each_reaching_splat(const BinViews& bins, Span<const Splat> splats, const std::vector<PixelRect>& bounds,
                              int tile, const TilePixels& tp, More more, F f) {
   const TileRange r = bins.ranges[tile];
   for (int32_t k = r.begin; k < r.end && more(); ++k) {
     const int32_t g = bins.values[k];
-    TilePixels p;
+    PixelRect p;
     if (reach(bounds[size_t(g)], tp, p)) f(k, g, splats[g], p);
   }
 }
 
 // The tile's entries set to zero: an entry whose splat misses the tile, or that an early stop never
 // reaches, holds no gradient (the scratch keeps an earlier pass's values otherwise).
-void clear_entries(const BinViews& bins, int tile, Span<SplatGrad> entries) {
+void clear_entries(const BinViews& bins, int tile, std::vector<SplatGrad>& entries) {
   const TileRange r = bins.ranges[tile];
-  if (r.end > r.begin) std::memset(&entries[r.begin], 0, size_t(r.end - r.begin) * sizeof(SplatGrad));
+  if (r.end > r.begin) std::memset(&entries[size_t(r.begin)], 0, size_t(r.end - r.begin) * sizeof(SplatGrad));
+}
+
+// Pass 2's pairs: per tile the (entry, pixel) pairs its forward visits, as offsets into G.
+void base_pairs(const View& v, const BinViews& bins, CpuRasterScratch& s) {
+  const int tiles = v.tiles_x() * v.tiles_y();
+  s.pair_offset.assign(size_t(tiles) + 1, 0);
+#pragma omp parallel for schedule(dynamic, 4)
+  for (int t = 0; t < tiles; ++t) {
+    const TilePixels tp = tile_pixels(v, t);
+    const TileRange r = bins.ranges[t];
+    int64_t n = 0;
+    for (int32_t k = r.begin; k < r.end; ++k) {
+      PixelRect p;
+      if (reach(s.reach[size_t(bins.values[k])], tp, p)) n += int64_t(p.x1 - p.x0) * (p.y1 - p.y0);
+    }
+    s.pair_offset[size_t(t) + 1] = n;
+  }
+  for (int t = 0; t < tiles; ++t) s.pair_offset[size_t(t) + 1] += s.pair_offset[size_t(t)];
+  s.G.resize(size_t(s.pair_offset.back()));
 }
 
 // v_splats[g] += the entries k of splat g (values[k] == g), in increasing k. Each thread owns a
 // contiguous range of splats and scans every entry, so each splat's sum has one order whatever the
 // number of threads.
-void sum_entries(const BinViews& bins, Span<const SplatGrad> entries, Span<SplatGrad> v_splats) {
+void sum_entries(const BinViews& bins, const std::vector<SplatGrad>& entries, Span<SplatGrad> v_splats) {
   const int64_t n = v_splats.size, m = bins.values.size;
   constexpr int kFields = int(sizeof(SplatGrad) / sizeof(float));
 #pragma omp parallel
@@ -87,9 +106,9 @@ void sum_entries(const BinViews& bins, Span<const SplatGrad> entries, Span<Splat
     const int64_t g0 = n * part / parts, g1 = n * (part + 1) / parts;
     for (int64_t k = 0; k < m; ++k) {
       const int32_t g = bins.values[k];
-      if (g < g0 || g >= g1 || is_zero(entries[k])) continue;
+      if (g < g0 || g >= g1 || is_zero(entries[size_t(k)])) continue;
       float* d = &v_splats[g].mean[0];
-      const float* e = &entries[k].mean[0];
+      const float* e = &entries[size_t(k)].mean[0];
       for (int f = 0; f < kFields; ++f) d[f] += e[f];
     }
   }
@@ -105,22 +124,27 @@ void for_each_tile(const View& v, F f) {
 
 }  // namespace
 
-void base_fwd_cpu(BaseFwdArgs a) {
-  const std::vector<TilePixels> bounds = splat_reach(a.splats);
+void base_fwd_cpu(BaseFwdArgs a, CpuRasterScratch& scratch) {
+  splat_reach(a.splats, scratch.reach);
+  base_pairs(a.view, a.bins, scratch);
   for_each_tile(a.view, [&](int tile) {
     const TilePixels tp = tile_pixels(a.view, tile);
     BaseAccumT<float> acc[kTilePixels];
     float D_t[kTilePixels];
     for (int y = tp.y0; y < tp.y1; ++y)
       for (int x = tp.x0; x < tp.x1; ++x) D_t[tp.local(x, y)] = a.D_t(x, y);
-    const auto splat_fwd = [&](int32_t, int32_t, const Splat& s, const TilePixels& p) {
+    float* G = scratch.G.data() + scratch.pair_offset[size_t(tile)];  // this tile's pairs, in visiting order
+    const auto splat_fwd = [&](int32_t, int32_t, const Splat& s, const PixelRect& p) {
       for (int y = p.y0; y < p.y1; ++y)
         for (int x = p.x0; x < p.x1; ++x) {
           const int l = tp.local(x, y);
-          base_accumulate(acc[l], s, float(x), float(y), D_t[l], a.eps);
+          SplatFalloffT<float> f{};
+          const float alpha = base_falloff(s, float(x), float(y), D_t[l], a.eps, f);
+          *G++ = alpha != 0.0f ? f.G : 0.0f;
+          if (alpha != 0.0f) base_add(acc[l], s, alpha);
         }
     };
-    for_each_reaching_splat(a.bins, a.splats, bounds, tile, tp, [] { return true; }, splat_fwd);
+    for_each_reaching_splat(a.bins, a.splats, scratch.reach, tile, tp, [] { return true; }, splat_fwd);
     for (int y = tp.y0; y < tp.y1; ++y)
       for (int x = tp.x0; x < tp.x1; ++x) {
         const int l = tp.local(x, y);
@@ -136,8 +160,13 @@ void base_fwd_cpu(BaseFwdArgs a) {
   });
 }
 
-void base_bwd_cpu(BaseBwdArgs a, Span<SplatGrad> entries) {
-  const std::vector<TilePixels> bounds = splat_reach(a.splats);
+void base_bwd_cpu(BaseBwdArgs a, CpuRasterScratch& scratch) {
+  const int tiles = a.view.tiles_x() * a.view.tiles_y();
+  if (scratch.reach.size() != size_t(a.splats.size) || scratch.pair_offset.size() != size_t(tiles) + 1 ||
+      scratch.G.size() != size_t(scratch.pair_offset.back()))
+    throw std::logic_error("base_bwd_cpu: the scratch does not hold this render's forward pass");
+  std::vector<SplatGrad>& entries = scratch.entries;
+  entries.resize(size_t(a.bins.values.size));
   for_each_tile(a.view, [&](int tile) {
     clear_entries(a.bins, tile, entries);
     const TilePixels tp = tile_pixels(a.view, tile);
@@ -156,22 +185,29 @@ void base_bwd_cpu(BaseBwdArgs a, Span<SplatGrad> entries) {
         up[l] = base_resolve_bwd(a.W_g(x, y), D_t[l], Vec3<float>(a.C_b(x, y)), a.D_b(x, y), v_C_b, v_D_b);
       }
     if (!any) return;
-    const auto splat_bwd = [&](int32_t k, int32_t, const Splat& s, const TilePixels& p) {
+    // The forward's falloffs of this tile's pairs, in the same visiting order: alpha and the
+    // gradient from them are those base_splat_bwd would compute, bit for bit.
+    const float* G = scratch.G.data() + scratch.pair_offset[size_t(tile)];
+    const auto splat_bwd = [&](int32_t k, int32_t, const Splat& s, const PixelRect& p) {
       SplatGrad v{};
       for (int y = p.y0; y < p.y1; ++y)
         for (int x = p.x0; x < p.x1; ++x) {
           const int l = tp.local(x, y);
-          if (active[l]) base_splat_bwd(s, float(x), float(y), D_t[l], a.eps, up[l], v);
+          const float g = *G++;
+          if (g == 0.0f || !active[l]) continue;
+          const SplatFalloffT<float> f{s.mean[0] - float(x), s.mean[1] - float(y), g, true};
+          base_splat_bwd(s, f, splat_alpha(s, f, 1.0f), up[l], v);
         }
-      entries[k] = v;
+      entries[size_t(k)] = v;
     };
-    for_each_reaching_splat(a.bins, a.splats, bounds, tile, tp, [] { return true; }, splat_bwd);
+    for_each_reaching_splat(a.bins, a.splats, scratch.reach, tile, tp, [] { return true; }, splat_bwd);
   });
   sum_entries(a.bins, entries, a.v_splats);
 }
 
 void refl_fwd_cpu(ReflFwdArgs a) {
-  const std::vector<TilePixels> bounds = splat_reach(a.splats);
+  std::vector<PixelRect> bounds;
+  splat_reach(a.splats, bounds);
   for_each_tile(a.view, [&](int tile) {
     const TilePixels tp = tile_pixels(a.view, tile);
     ReflStateT<float> st[kTilePixels];
@@ -185,7 +221,7 @@ void refl_fwd_cpu(ReflFwdArgs a) {
         alive[l] = refl_pixel_active(a.mode, a.plane, I[l]);
         live += alive[l] ? 1 : 0;
       }
-    const auto splat_fwd = [&](int32_t, int32_t g, const Splat& s, const TilePixels& p) {
+    const auto splat_fwd = [&](int32_t, int32_t g, const Splat& s, const PixelRect& p) {
       for (int y = p.y0; y < p.y1; ++y)
         for (int x = p.x0; x < p.x1; ++x) {
           const int l = tp.local(x, y);
@@ -204,8 +240,10 @@ void refl_fwd_cpu(ReflFwdArgs a) {
   });
 }
 
-void refl_bwd_cpu(ReflBwdArgs a, Span<SplatGrad> entries) {
-  const std::vector<TilePixels> bounds = splat_reach(a.splats);
+void refl_bwd_cpu(ReflBwdArgs a, CpuRasterScratch& scratch) {
+  splat_reach(a.splats, scratch.reach);
+  std::vector<SplatGrad>& entries = scratch.entries;
+  entries.resize(size_t(a.bins.values.size));
   for_each_tile(a.view, [&](int tile) {
     clear_entries(a.bins, tile, entries);
     const TilePixels tp = tile_pixels(a.view, tile);
@@ -227,7 +265,7 @@ void refl_bwd_cpu(ReflBwdArgs a, Span<SplatGrad> entries) {
         alive[l] = true;
         ++live;
       }
-    const auto splat_bwd = [&](int32_t k, int32_t g, const Splat& s, const TilePixels& p) {
+    const auto splat_bwd = [&](int32_t k, int32_t g, const Splat& s, const PixelRect& p) {
       SplatGrad v{};
       for (int y = p.y0; y < p.y1; ++y)
         for (int x = p.x0; x < p.x1; ++x) {
@@ -236,9 +274,9 @@ void refl_bwd_cpu(ReflBwdArgs a, Span<SplatGrad> entries) {
           if (!refl_step_bwd(st[l], s, float(x), float(y), C_final[l], W_final[l], v_C[l], 0.0f, v))
             alive[l] = false, --live;
         }
-      entries[k] = v;
+      entries[size_t(k)] = v;
     };
-    for_each_reaching_splat(a.bins, a.splats, bounds, tile, tp, [&] { return live > 0; }, splat_bwd);
+    for_each_reaching_splat(a.bins, a.splats, scratch.reach, tile, tp, [&] { return live > 0; }, splat_bwd);
   });
   sum_entries(a.bins, entries, a.v_splats);
 }

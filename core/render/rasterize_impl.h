@@ -7,6 +7,7 @@
 #include "core/common/atomics.h"
 #include "core/common/parallel_for.h"
 #include "core/render/blend_device.h"
+#include "core/render/rasterize_cpu_scratch.h"
 #include "core/render/splat_grad_ops.h"
 #include "core/render/stage_args.h"
 
@@ -151,16 +152,17 @@ void mask_group(Backend b, ImageView<const int32_t> I, int32_t plane, ImageView<
   });
 }
 
-void base_fwd_cpu(BaseFwdArgs a);
+// The CPU passes keep their scratch in a CpuRasterScratch (rasterize_cpu_scratch.h): base_bwd_cpu
+// reads the falloffs that base_fwd_cpu stored in it for the same render (same splats, bins and
+// D_t; std::logic_error when it holds no such forward), and both backward passes sum each splat's
+// gradient from per-entry sums in entry order, whatever the number of threads.
+void base_fwd_cpu(BaseFwdArgs a, CpuRasterScratch& scratch);
 void base_fwd_cuda(BaseFwdArgs a);
-// The CPU backward passes take a scratch of at least a.bins.values.size entries: each (tile, splat)
-// entry's gradient, summed over the tile, before they are added into a.v_splats in entry order
-// (rasterize_cpu.cpp; the result does not depend on the number of threads).
-void base_bwd_cpu(BaseBwdArgs a, Span<SplatGrad> entries);
+void base_bwd_cpu(BaseBwdArgs a, CpuRasterScratch& scratch);
 void base_bwd_cuda(BaseBwdArgs a);
 void refl_fwd_cpu(ReflFwdArgs a);
 void refl_fwd_cuda(ReflFwdArgs a);
-void refl_bwd_cpu(ReflBwdArgs a, Span<SplatGrad> entries);
+void refl_bwd_cpu(ReflBwdArgs a, CpuRasterScratch& scratch);
 void refl_bwd_cuda(ReflBwdArgs a);
 void composite_cpu(ImageView<const Eigen::Vector3f> C_b, ImageView<const float> R, ImageView<const Eigen::Vector3f> C_r, ImageView<Eigen::Vector3f> C);
 void composite_cuda(ImageView<const Eigen::Vector3f> C_b, ImageView<const float> R, ImageView<const Eigen::Vector3f> C_r, ImageView<Eigen::Vector3f> C);

@@ -173,7 +173,7 @@ void Renderer::render(const RenderCamera& camera, const GaussianSet& base, const
     kernel::BaseFwdArgs a{vb, params_.eps, first(base_.splats, nb), base_.bins.views(), raycast.C_t.view(),
                           raycast.D_t.view(), out.C_g.view(), out.C_b.view(), out.W_g.view(), out.D_g.view(),
                           out.D_b.view()};
-    RRG_DISPATCH(device_, kernel::base_fwd_cpu(a), kernel::base_fwd_cuda(a));
+    RRG_DISPATCH(device_, kernel::base_fwd_cpu(a, base_.cpu), kernel::base_fwd_cuda(a));
   });
   timings_.reflection_ms = timed(t, device_, [&] { reflection_forward(vr, raycast.I, out); });
   timings_.composite_ms = timed(t, device_, [&] {
@@ -255,7 +255,7 @@ void Renderer::backward(const RenderUpstream& up, GaussianGrads& v_base, Gaussia
     kernel::BaseBwdArgs a{vb, params_.eps, first(base_.splats, nb), base_.bins.views(), in.D_t.view(),
                           out.W_g.view(), out.D_b.view(), out.C_b.view(), up.v_C.view(), up.v_D_b.view(),
                           first(base_.v_splats, nb)};
-    RRG_DISPATCH(device_, kernel::base_bwd_cpu(a, entry_scratch(base_)), kernel::base_bwd_cuda(a));
+    RRG_DISPATCH(device_, kernel::base_bwd_cpu(a, base_.cpu), kernel::base_bwd_cuda(a));
     // composite: v_C_r = R v_C (+ v_C_r)
     v_C_r_.ensure(K.width, K.height, device_);
     const auto extra = has_v_C_r ? up.v_C_r.view() : ImageView<const Color>{};
@@ -274,11 +274,6 @@ void Renderer::backward(const RenderUpstream& up, GaussianGrads& v_base, Gaussia
   });
 }
 
-Span<kernel::SplatGrad> Renderer::entry_scratch(Projected& p) {
-  ensure_size(p.entry_grads, p.bins.entries(), device_);
-  return first(p.entry_grads, p.bins.entries());
-}
-
 void Renderer::reflection_backward(const kernel::View& view, const DeviceImage<Color>& v_C_r) {
   const GaussianSet& set = *refl_set_;
   const int64_t n = int64_t(set.size());
@@ -292,14 +287,14 @@ void Renderer::reflection_backward(const kernel::View& view, const DeviceImage<C
   if (params_.variant != ReflectionVariant::MultiPass) {
     const auto a = args(params_.variant == ReflectionVariant::Grouped ? kernel::PlaneMode::Match
                                                                        : kernel::PlaneMode::All, 0);
-    RRG_DISPATCH(device_, kernel::refl_bwd_cpu(a, entry_scratch(refl_)), kernel::refl_bwd_cuda(a));
+    RRG_DISPATCH(device_, kernel::refl_bwd_cpu(a, refl_.cpu), kernel::refl_bwd_cuda(a));
     return;
   }
   // Multi-pass: group k's image only reaches pixels with I(u) == k, so only those carry gradient.
   for (int32_t k : reflection_groups()) {
     refl_.bins.build(view, splats, first(refl_.rects, n), set.plane_ids(), k, true, device_);
     const auto a = args(kernel::PlaneMode::PixelOnly, k);
-    RRG_DISPATCH(device_, kernel::refl_bwd_cpu(a, entry_scratch(refl_)), kernel::refl_bwd_cuda(a));
+    RRG_DISPATCH(device_, kernel::refl_bwd_cpu(a, refl_.cpu), kernel::refl_bwd_cuda(a));
   }
 }
 

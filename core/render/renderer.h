@@ -11,6 +11,7 @@
 // The renderer owns all scratch memory and reuses it across frames.
 #include "core/gaussians/gaussian_grads.h"
 #include "core/gaussians/gaussian_set.h"
+#include "core/render/rasterize_cpu_scratch.h"
 #include "core/render/render_types.h"
 #include "core/render/splat.h"
 #include "core/render/tile_bins.h"
@@ -70,10 +71,9 @@ class Renderer {
     Buffer<kernel::Splat> splats;
     Buffer<kernel::TileRect> rects;
     Buffer<kernel::SplatGrad> v_splats;
-    Buffer<kernel::SplatGrad> entry_grads;  // CPU backward: one per bin entry (rasterize_impl.h)
     TileBins bins;
+    kernel::CpuRasterScratch cpu;  // the CPU schedule's scratch (rasterize_cpu_scratch.h)
   };
-  Span<kernel::SplatGrad> entry_scratch(Projected& p);
   kernel::View make_view(const RenderCamera& camera, const GaussianSet& set) const;
   void project(const kernel::View& view, const GaussianSet& set, Projected& p);
   void reflection_forward(const kernel::View& view, const DeviceImage<int32_t>& I, RenderOutputs& out,

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 namespace rrg::kernel {
@@ -97,13 +98,16 @@ Span<const T> cspan(const std::vector<T>& v) {
   return {v.data(), int64_t(v.size())};
 }
 
-// The CPU backward's entry scratch for a scene, filled with NaN: every entry a pass reads must be
-// one it wrote in that pass.
-std::vector<SplatGrad> entry_scratch(const Scene& sc) {
+// A CPU scratch for a scene whose backward entries and pass-2 falloffs hold NaN: every value a
+// pass reads must be one it (or, for the falloffs, the forward of the same render) wrote.
+CpuRasterScratch poisoned_scratch(const Scene& sc) {
+  CpuRasterScratch s;
   SplatGrad nan{};
   float* f = &nan.mean[0];
   for (int k = 0; k < int(sizeof(SplatGrad) / sizeof(float)); ++k) f[k] = std::nanf("");
-  return std::vector<SplatGrad>(sc.values.size(), nan);
+  s.entries.assign(sc.values.size(), nan);
+  s.G.assign(sc.values.size() * 8, std::nanf(""));
+  return s;
 }
 template <class T>
 Span<T> span(std::vector<T>& v) {
@@ -180,7 +184,8 @@ TEST(RasterizeSchedule, BasePassMatchesThePerPixelLoop) {
   Scene sc = make_scene(11, 300);
   const size_t n = sc.C_t.size();
   BaseOut tiled(n), pixel(n);
-  base_fwd_cpu(base_fwd_args(sc, tiled));
+  CpuRasterScratch scratch = poisoned_scratch(sc);
+  base_fwd_cpu(base_fwd_args(sc, tiled), scratch);
   base_fwd(CpuBackend{}, base_fwd_args(sc, pixel));
   int64_t covered = 0;
   for (size_t i = 0; i < n; ++i) {
@@ -209,8 +214,11 @@ TEST(RasterizeSchedule, BasePassMatchesThePerPixelLoop) {
   b.v_D_b = cimg(sc.v_D, sc);
   std::vector<SplatGrad> g_tiled(sc.splats.size(), SplatGrad{}), g_pixel(sc.splats.size(), SplatGrad{});
   b.v_splats = {g_tiled.data(), int64_t(g_tiled.size())};
-  std::vector<SplatGrad> scratch = entry_scratch(sc);
-  base_bwd_cpu(b, span(scratch));
+  {
+    CpuRasterScratch fresh;  // no forward pass in it
+    EXPECT_THROW(base_bwd_cpu(b, fresh), std::logic_error);
+  }
+  base_bwd_cpu(b, scratch);  // the falloffs of the tiled forward above
   b.v_splats = {g_pixel.data(), int64_t(g_pixel.size())};
   base_bwd(CpuBackend{}, b);
   int nonzero = 0;
@@ -267,8 +275,8 @@ TEST_P(ReflSchedule, ReflectionPassMatchesThePerPixelLoop) {
   b.v_C_r = cimg(sc.v_C, sc);
   std::vector<SplatGrad> g_tiled(sc.splats.size(), SplatGrad{}), g_pixel(sc.splats.size(), SplatGrad{});
   b.v_splats = {g_tiled.data(), int64_t(g_tiled.size())};
-  std::vector<SplatGrad> scratch = entry_scratch(sc);
-  refl_bwd_cpu(b, span(scratch));
+  CpuRasterScratch scratch = poisoned_scratch(sc);
+  refl_bwd_cpu(b, scratch);
   b.v_splats = {g_pixel.data(), int64_t(g_pixel.size())};
   refl_bwd(CpuBackend{}, b);
   int nonzero = 0;
@@ -304,7 +312,10 @@ TEST(RasterizeSchedule, BackwardGradientsDoNotDependOnTheThreadCount) {
                      [&](int32_t p, int32_t q) { return sc.splats[size_t(p)].depth < sc.splats[size_t(q)].depth; });
   const size_t n = sc.C_t.size();
   BaseOut fwd(n);
-  base_fwd_cpu(base_fwd_args(sc, fwd));
+  {
+    CpuRasterScratch unused;
+    base_fwd_cpu(base_fwd_args(sc, fwd), unused);
+  }
   std::vector<Eigen::Vector3f> C_r(n);
   std::vector<float> W_r(n);
   ReflFwdArgs rf{};
@@ -320,7 +331,10 @@ TEST(RasterizeSchedule, BackwardGradientsDoNotDependOnTheThreadCount) {
 
   const auto backward = [&] {
     std::vector<SplatGrad> base(sc.splats.size(), SplatGrad{}), refl(sc.splats.size(), SplatGrad{});
-    std::vector<SplatGrad> scratch = entry_scratch(sc);
+    CpuRasterScratch scratch = poisoned_scratch(sc);
+    BaseOut again(n);
+    base_fwd_cpu(base_fwd_args(sc, again), scratch);  // on this thread count too
+    EXPECT_EQ(std::memcmp(again.C_b.data(), fwd.C_b.data(), n * sizeof(Eigen::Vector3f)), 0);
     BaseBwdArgs b{};
     b.view = sc.view;
     b.eps = 0.05f;
@@ -333,7 +347,7 @@ TEST(RasterizeSchedule, BackwardGradientsDoNotDependOnTheThreadCount) {
     b.v_C_b = cimg(sc.v_C, sc);
     b.v_D_b = cimg(sc.v_D, sc);
     b.v_splats = span(base);
-    base_bwd_cpu(b, span(scratch));
+    base_bwd_cpu(b, scratch);
     ReflBwdArgs r{};
     r.view = sc.view;
     r.splats = cspan(sc.splats);
@@ -345,7 +359,7 @@ TEST(RasterizeSchedule, BackwardGradientsDoNotDependOnTheThreadCount) {
     r.W_r = cimg(W_r, sc);
     r.v_C_r = cimg(sc.v_C, sc);
     r.v_splats = span(refl);
-    refl_bwd_cpu(r, span(scratch));  // the same scratch again: it must not carry pass 2's entries
+    refl_bwd_cpu(r, scratch);  // the same scratch again: it must not carry pass 2's entries
     return std::pair{base, refl};
   };
   std::pair<std::vector<SplatGrad>, std::vector<SplatGrad>> one;
