@@ -75,7 +75,9 @@ void clear_entries(const BinViews& bins, int tile, std::vector<SplatGrad>& entri
   if (r.end > r.begin) std::memset(&entries[size_t(r.begin)], 0, size_t(r.end - r.begin) * sizeof(SplatGrad));
 }
 
-// Pass 2's pairs: per tile the (entry, pixel) pairs its forward visits, as offsets into G.
+// Pass 2's pairs: per tile the (entry, pixel) pairs its forward visits, as offsets into G; G is
+// sized for them when they are at most s.max_kept_pairs, and left empty (falloffs not kept, the
+// backward evaluates them again) above, so that the scratch stays within 4 · max_kept_pairs bytes.
 void base_pairs(const View& v, const BinViews& bins, CpuRasterScratch& s) {
   const int tiles = v.tiles_x() * v.tiles_y();
   s.pair_offset.assign(size_t(tiles) + 1, 0);
@@ -91,7 +93,12 @@ void base_pairs(const View& v, const BinViews& bins, CpuRasterScratch& s) {
     s.pair_offset[size_t(t) + 1] = n;
   }
   for (int t = 0; t < tiles; ++t) s.pair_offset[size_t(t) + 1] += s.pair_offset[size_t(t)];
-  s.G.resize(size_t(s.pair_offset.back()));
+  if (s.pair_offset.back() <= s.max_kept_pairs) {
+    s.G.resize(size_t(s.pair_offset.back()));
+  } else {
+    s.G.clear();
+    s.G.shrink_to_fit();
+  }
 }
 
 // v_splats[g] += the entries k of splat g (values[k] == g), in increasing k. Each thread owns a
@@ -133,14 +140,15 @@ void base_fwd_cpu(BaseFwdArgs a, CpuRasterScratch& scratch) {
     float D_t[kTilePixels];
     for (int y = tp.y0; y < tp.y1; ++y)
       for (int x = tp.x0; x < tp.x1; ++x) D_t[tp.local(x, y)] = a.D_t(x, y);
-    float* G = scratch.G.data() + scratch.pair_offset[size_t(tile)];  // this tile's pairs, in visiting order
+    const bool keep = !scratch.G.empty();
+    float* G = keep ? scratch.G.data() + scratch.pair_offset[size_t(tile)] : nullptr;  // this tile's pairs
     const auto splat_fwd = [&](int32_t, int32_t, const Splat& s, const PixelRect& p) {
       for (int y = p.y0; y < p.y1; ++y)
         for (int x = p.x0; x < p.x1; ++x) {
           const int l = tp.local(x, y);
           SplatFalloffT<float> f{};
           const float alpha = base_falloff(s, float(x), float(y), D_t[l], a.eps, f);
-          *G++ = alpha != 0.0f ? f.G : 0.0f;
+          if (keep) *G++ = alpha != 0.0f ? f.G : 0.0f;
           if (alpha != 0.0f) base_add(acc[l], s, alpha);
         }
     };
@@ -163,8 +171,9 @@ void base_fwd_cpu(BaseFwdArgs a, CpuRasterScratch& scratch) {
 void base_bwd_cpu(BaseBwdArgs a, CpuRasterScratch& scratch) {
   const int tiles = a.view.tiles_x() * a.view.tiles_y();
   if (scratch.reach.size() != size_t(a.splats.size) || scratch.pair_offset.size() != size_t(tiles) + 1 ||
-      scratch.G.size() != size_t(scratch.pair_offset.back()))
+      (scratch.G.size() != size_t(scratch.pair_offset.back()) && scratch.pair_offset.back() <= scratch.max_kept_pairs))
     throw std::logic_error("base_bwd_cpu: the scratch does not hold this render's forward pass");
+  const bool kept = scratch.pair_offset.back() <= scratch.max_kept_pairs;
   std::vector<SplatGrad>& entries = scratch.entries;
   entries.resize(size_t(a.bins.values.size));
   for_each_tile(a.view, [&](int tile) {
@@ -187,12 +196,16 @@ void base_bwd_cpu(BaseBwdArgs a, CpuRasterScratch& scratch) {
     if (!any) return;
     // The forward's falloffs of this tile's pairs, in the same visiting order: alpha and the
     // gradient from them are those base_splat_bwd would compute, bit for bit.
-    const float* G = scratch.G.data() + scratch.pair_offset[size_t(tile)];
+    const float* G = kept ? scratch.G.data() + scratch.pair_offset[size_t(tile)] : nullptr;
     const auto splat_bwd = [&](int32_t k, int32_t, const Splat& s, const PixelRect& p) {
       SplatGrad v{};
       for (int y = p.y0; y < p.y1; ++y)
         for (int x = p.x0; x < p.x1; ++x) {
           const int l = tp.local(x, y);
+          if (!kept) {
+            if (active[l]) base_splat_bwd(s, float(x), float(y), D_t[l], a.eps, up[l], v);
+            continue;
+          }
           const float g = *G++;
           if (g == 0.0f || !active[l]) continue;
           const SplatFalloffT<float> f{s.mean[0] - float(x), s.mean[1] - float(y), g, true};

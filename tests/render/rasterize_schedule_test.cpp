@@ -329,9 +329,10 @@ TEST(RasterizeSchedule, BackwardGradientsDoNotDependOnTheThreadCount) {
   rf.W_r = img(W_r, sc);
   refl_fwd_cpu(rf);
 
-  const auto backward = [&] {
+  const auto backward = [&](int64_t max_kept_pairs = kMaxKeptPairs) {
     std::vector<SplatGrad> base(sc.splats.size(), SplatGrad{}), refl(sc.splats.size(), SplatGrad{});
     CpuRasterScratch scratch = poisoned_scratch(sc);
+    scratch.max_kept_pairs = max_kept_pairs;
     BaseOut again(n);
     base_fwd_cpu(base_fwd_args(sc, again), scratch);  // on this thread count too
     EXPECT_EQ(std::memcmp(again.C_b.data(), fwd.C_b.data(), n * sizeof(Eigen::Vector3f)), 0);
@@ -370,6 +371,11 @@ TEST(RasterizeSchedule, BackwardGradientsDoNotDependOnTheThreadCount) {
   int nonzero = 0;
   for (const SplatGrad& g : one.first) nonzero += is_zero(g) ? 0 : 1;
   EXPECT_GT(nonzero, 200);
+  {  // the falloffs not kept (a render with more pairs than the cap): evaluated again, the same
+    const Threads t(1);
+    const auto again = backward(0);
+    EXPECT_TRUE(bitwise_equal(again.first, one.first)) << "falloffs evaluated again in the backward";
+  }
   for (const int threads : {2, 3, 4})
     for (int rep = 0; rep < 4; ++rep) {
       const Threads t(threads);
