@@ -109,10 +109,6 @@ CpuRasterScratch poisoned_scratch(const Scene& sc) {
   s.G.assign(sc.values.size() * 8, std::nanf(""));
   return s;
 }
-template <class T>
-Span<T> span(std::vector<T>& v) {
-  return {v.data(), int64_t(v.size())};
-}
 
 struct BaseOut {
   std::vector<Eigen::Vector3f> C_g, C_b;
@@ -134,6 +130,63 @@ BaseFwdArgs base_fwd_args(Scene& sc, BaseOut& o) {
   a.D_g = img(o.D_g, sc);
   a.D_b = img(o.D_b, sc);
   return a;
+}
+
+// Pass 2's backward over the forward's images fwd, from the scene's upstream gradients, into out.
+BaseBwdArgs base_bwd_args(const Scene& sc, const BaseOut& fwd, std::vector<SplatGrad>& out) {
+  BaseBwdArgs b{};
+  b.view = sc.view;
+  b.eps = 0.05f;
+  b.splats = cspan(sc.splats);
+  b.bins = {cspan(sc.values), cspan(sc.ranges)};
+  b.D_t = cimg(sc.D_t, sc);
+  b.W_g = cimg(fwd.W_g, sc);
+  b.D_b = cimg(fwd.D_b, sc);
+  b.C_b = cimg(fwd.C_b, sc);
+  b.v_C_b = cimg(sc.v_C, sc);
+  b.v_D_b = cimg(sc.v_D, sc);
+  b.v_splats = {out.data(), int64_t(out.size())};
+  return b;
+}
+
+// Pass 3 into C_r, W_r (plane 1 for PixelOnly).
+ReflFwdArgs refl_fwd_args(const Scene& sc, PlaneMode mode, std::vector<Eigen::Vector3f>& C_r, std::vector<float>& W_r) {
+  ReflFwdArgs a{};
+  a.view = sc.view;
+  a.splats = cspan(sc.splats);
+  a.bins = {cspan(sc.values), cspan(sc.ranges)};
+  a.plane_ids = cspan(sc.plane_ids);
+  a.I = cimg(sc.I, sc);
+  a.mode = mode;
+  a.plane = 1;
+  a.C_r = img(C_r, sc);
+  a.W_r = img(W_r, sc);
+  return a;
+}
+
+// Pass 3's backward over the forward's C_r, W_r, from the scene's upstream gradients, into out.
+ReflBwdArgs refl_bwd_args(const Scene& sc, PlaneMode mode, const std::vector<Eigen::Vector3f>& C_r,
+                          const std::vector<float>& W_r, std::vector<SplatGrad>& out) {
+  ReflBwdArgs b{};
+  b.view = sc.view;
+  b.splats = cspan(sc.splats);
+  b.bins = {cspan(sc.values), cspan(sc.ranges)};
+  b.plane_ids = cspan(sc.plane_ids);
+  b.I = cimg(sc.I, sc);
+  b.mode = mode;
+  b.plane = 1;
+  b.C_r = cimg(C_r, sc);
+  b.W_r = cimg(W_r, sc);
+  b.v_C_r = cimg(sc.v_C, sc);
+  b.v_splats = {out.data(), int64_t(out.size())};
+  return b;
+}
+
+// Pass 3 composites front to back: every tile's list sorted by depth, as the binning does.
+void sort_lists_by_depth(Scene& sc) {
+  for (const TileRange& r : sc.ranges)
+    std::stable_sort(sc.values.begin() + r.begin, sc.values.begin() + r.end,
+                     [&](int32_t p, int32_t q) { return sc.splats[size_t(p)].depth < sc.splats[size_t(q)].depth; });
 }
 
 void expect_close(const SplatGrad& got, const SplatGrad& want, int g) {
@@ -201,19 +254,8 @@ TEST(RasterizeSchedule, BasePassMatchesThePerPixelLoop) {
   EXPECT_GT(covered, int64_t(n) * 9 / 10);
 
   // Backward from random upstream gradients (zero at some pixels).
-  BaseBwdArgs b{};
-  b.view = sc.view;
-  b.eps = 0.05f;
-  b.splats = cspan(sc.splats);
-  b.bins = {cspan(sc.values), cspan(sc.ranges)};
-  b.D_t = cimg(sc.D_t, sc);
-  b.W_g = cimg(pixel.W_g, sc);
-  b.D_b = cimg(pixel.D_b, sc);
-  b.C_b = cimg(pixel.C_b, sc);
-  b.v_C_b = cimg(sc.v_C, sc);
-  b.v_D_b = cimg(sc.v_D, sc);
   std::vector<SplatGrad> g_tiled(sc.splats.size(), SplatGrad{}), g_pixel(sc.splats.size(), SplatGrad{});
-  b.v_splats = {g_tiled.data(), int64_t(g_tiled.size())};
+  BaseBwdArgs b = base_bwd_args(sc, pixel, g_tiled);
   {
     CpuRasterScratch fresh;  // no forward pass in it
     EXPECT_THROW(base_bwd_cpu(b, fresh), std::logic_error);
@@ -233,23 +275,11 @@ class ReflSchedule : public ::testing::TestWithParam<PlaneMode> {};
 
 TEST_P(ReflSchedule, ReflectionPassMatchesThePerPixelLoop) {
   Scene sc = make_scene(23, 300);
-  // Pass 3 composites front to back: sort every tile's list by depth, as the binning does.
-  for (const TileRange& r : sc.ranges)
-    std::stable_sort(sc.values.begin() + r.begin, sc.values.begin() + r.end,
-                     [&](int32_t p, int32_t q) { return sc.splats[size_t(p)].depth < sc.splats[size_t(q)].depth; });
+  sort_lists_by_depth(sc);
   const size_t n = sc.C_t.size();
   std::vector<Eigen::Vector3f> C_tiled(n), C_pixel(n);
   std::vector<float> W_tiled(n), W_pixel(n);
-  ReflFwdArgs a{};
-  a.view = sc.view;
-  a.splats = cspan(sc.splats);
-  a.bins = {cspan(sc.values), cspan(sc.ranges)};
-  a.plane_ids = cspan(sc.plane_ids);
-  a.I = cimg(sc.I, sc);
-  a.mode = GetParam();
-  a.plane = 1;
-  a.C_r = img(C_tiled, sc);
-  a.W_r = img(W_tiled, sc);
+  ReflFwdArgs a = refl_fwd_args(sc, GetParam(), C_tiled, W_tiled);
   refl_fwd_cpu(a);
   a.C_r = img(C_pixel, sc);
   a.W_r = img(W_pixel, sc);
@@ -262,19 +292,8 @@ TEST_P(ReflSchedule, ReflectionPassMatchesThePerPixelLoop) {
   }
   EXPECT_GT(saturated, 0);  // early termination is exercised
 
-  ReflBwdArgs b{};
-  b.view = sc.view;
-  b.splats = cspan(sc.splats);
-  b.bins = {cspan(sc.values), cspan(sc.ranges)};
-  b.plane_ids = cspan(sc.plane_ids);
-  b.I = cimg(sc.I, sc);
-  b.mode = GetParam();
-  b.plane = 1;
-  b.C_r = cimg(C_pixel, sc);
-  b.W_r = cimg(W_pixel, sc);
-  b.v_C_r = cimg(sc.v_C, sc);
-  std::vector<SplatGrad> g_tiled(sc.splats.size(), SplatGrad{}), g_pixel(sc.splats.size(), SplatGrad{});
-  b.v_splats = {g_tiled.data(), int64_t(g_tiled.size())};
+  std::vector<SplatGrad> g_tiled(sc.splats.size()), g_pixel(sc.splats.size());
+  ReflBwdArgs b = refl_bwd_args(sc, GetParam(), C_pixel, W_pixel, g_tiled);
   CpuRasterScratch scratch = poisoned_scratch(sc);
   refl_bwd_cpu(b, scratch);
   b.v_splats = {g_pixel.data(), int64_t(g_pixel.size())};
@@ -307,9 +326,7 @@ bool bitwise_equal(const std::vector<SplatGrad>& a, const std::vector<SplatGrad>
 // gradient is a sum over several tiles' entries.
 TEST(RasterizeSchedule, BackwardGradientsDoNotDependOnTheThreadCount) {
   Scene sc = make_scene(5, 300);
-  for (const TileRange& r : sc.ranges)  // pass 3 composites front to back
-    std::stable_sort(sc.values.begin() + r.begin, sc.values.begin() + r.end,
-                     [&](int32_t p, int32_t q) { return sc.splats[size_t(p)].depth < sc.splats[size_t(q)].depth; });
+  sort_lists_by_depth(sc);
   const size_t n = sc.C_t.size();
   BaseOut fwd(n);
   {
@@ -318,16 +335,7 @@ TEST(RasterizeSchedule, BackwardGradientsDoNotDependOnTheThreadCount) {
   }
   std::vector<Eigen::Vector3f> C_r(n);
   std::vector<float> W_r(n);
-  ReflFwdArgs rf{};
-  rf.view = sc.view;
-  rf.splats = cspan(sc.splats);
-  rf.bins = {cspan(sc.values), cspan(sc.ranges)};
-  rf.plane_ids = cspan(sc.plane_ids);
-  rf.I = cimg(sc.I, sc);
-  rf.mode = PlaneMode::Match;
-  rf.C_r = img(C_r, sc);
-  rf.W_r = img(W_r, sc);
-  refl_fwd_cpu(rf);
+  refl_fwd_cpu(refl_fwd_args(sc, PlaneMode::Match, C_r, W_r));
 
   const auto backward = [&](int64_t max_kept_pairs = kMaxKeptPairs) {
     std::vector<SplatGrad> base(sc.splats.size(), SplatGrad{}), refl(sc.splats.size(), SplatGrad{});
@@ -336,31 +344,9 @@ TEST(RasterizeSchedule, BackwardGradientsDoNotDependOnTheThreadCount) {
     BaseOut again(n);
     base_fwd_cpu(base_fwd_args(sc, again), scratch);  // on this thread count too
     EXPECT_EQ(std::memcmp(again.C_b.data(), fwd.C_b.data(), n * sizeof(Eigen::Vector3f)), 0);
-    BaseBwdArgs b{};
-    b.view = sc.view;
-    b.eps = 0.05f;
-    b.splats = cspan(sc.splats);
-    b.bins = {cspan(sc.values), cspan(sc.ranges)};
-    b.D_t = cimg(sc.D_t, sc);
-    b.W_g = cimg(fwd.W_g, sc);
-    b.D_b = cimg(fwd.D_b, sc);
-    b.C_b = cimg(fwd.C_b, sc);
-    b.v_C_b = cimg(sc.v_C, sc);
-    b.v_D_b = cimg(sc.v_D, sc);
-    b.v_splats = span(base);
-    base_bwd_cpu(b, scratch);
-    ReflBwdArgs r{};
-    r.view = sc.view;
-    r.splats = cspan(sc.splats);
-    r.bins = {cspan(sc.values), cspan(sc.ranges)};
-    r.plane_ids = cspan(sc.plane_ids);
-    r.I = cimg(sc.I, sc);
-    r.mode = PlaneMode::Match;
-    r.C_r = cimg(C_r, sc);
-    r.W_r = cimg(W_r, sc);
-    r.v_C_r = cimg(sc.v_C, sc);
-    r.v_splats = span(refl);
-    refl_bwd_cpu(r, scratch);  // the same scratch again: it must not carry pass 2's entries
+    base_bwd_cpu(base_bwd_args(sc, fwd, base), scratch);
+    // the same scratch again: it must not carry pass 2's entries
+    refl_bwd_cpu(refl_bwd_args(sc, PlaneMode::Match, C_r, W_r, refl), scratch);
     return std::pair{base, refl};
   };
   std::pair<std::vector<SplatGrad>, std::vector<SplatGrad>> one;
