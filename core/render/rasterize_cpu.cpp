@@ -218,9 +218,8 @@ void base_bwd_cpu(BaseBwdArgs a, CpuRasterScratch& scratch) {
   sum_entries(a.bins, entries, a.v_splats);
 }
 
-void refl_fwd_cpu(ReflFwdArgs a) {
-  std::vector<PixelRect> bounds;
-  splat_reach(a.splats, bounds);
+void refl_fwd_cpu(ReflFwdArgs a, CpuRasterScratch& scratch) {
+  splat_reach(a.splats, scratch.reach);
   for_each_tile(a.view, [&](int tile) {
     const TilePixels tp = tile_pixels(a.view, tile);
     ReflStateT<float> st[kTilePixels];
@@ -243,7 +242,7 @@ void refl_fwd_cpu(ReflFwdArgs a) {
             alive[l] = false, --live;
         }
     };
-    for_each_reaching_splat(a.bins, a.splats, bounds, tile, tp, [&] { return live > 0; }, splat_fwd);
+    for_each_reaching_splat(a.bins, a.splats, scratch.reach, tile, tp, [&] { return live > 0; }, splat_fwd);
     for (int y = tp.y0; y < tp.y1; ++y)
       for (int x = tp.x0; x < tp.x1; ++x) {
         const int l = tp.local(x, y);
@@ -254,7 +253,8 @@ void refl_fwd_cpu(ReflFwdArgs a) {
 }
 
 void refl_bwd_cpu(ReflBwdArgs a, CpuRasterScratch& scratch) {
-  splat_reach(a.splats, scratch.reach);
+  if (scratch.reach.size() != size_t(a.splats.size))  // the forward's reach of the same splats
+    throw std::logic_error("refl_bwd_cpu: the scratch does not hold this render's forward pass");
   std::vector<SplatGrad>& entries = scratch.entries;
   entries.resize(size_t(a.bins.values.size));
   for_each_tile(a.view, [&](int tile) {

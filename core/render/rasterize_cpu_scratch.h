@@ -18,7 +18,8 @@ struct PixelRect {
 inline constexpr int64_t kMaxKeptPairs = int64_t(1) << 26;
 
 struct CpuRasterScratch {
-  std::vector<PixelRect> reach;      // per splat: the pixels where its alpha can be non-zero
+  std::vector<PixelRect> reach;      // per splat: the pixels where its alpha can be non-zero (each
+                                     // forward pass writes it, the backward of the same pass reads it)
   // Pass 2, written by base_fwd_cpu for base_bwd_cpu of the same render: the falloff G of every
   // (tile entry, pixel) pair the forward visits, in visiting order, 0 where the splat adds nothing
   // (depth cull, outside its ellipse, alpha below 1/255); pair_offset[t] is tile t's first pair.

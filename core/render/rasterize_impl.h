@@ -152,15 +152,16 @@ void mask_group(Backend b, ImageView<const int32_t> I, int32_t plane, ImageView<
   });
 }
 
-// The CPU passes keep their scratch in a CpuRasterScratch (rasterize_cpu_scratch.h): base_bwd_cpu
-// reads the falloffs that base_fwd_cpu stored in it for the same render (same splats, bins and
-// D_t; std::logic_error when it holds no such forward), and both backward passes sum each splat's
-// gradient from per-entry sums in entry order, whatever the number of threads.
+// The CPU passes keep their scratch in a CpuRasterScratch (rasterize_cpu_scratch.h): a backward pass
+// reads what the forward of the same pass stored in it for the same render (the splats' reach, and
+// for pass 2 the falloffs; same splats, bins and D_t; std::logic_error when it holds no such
+// forward), and both backward passes sum each splat's gradient from per-entry sums in entry order,
+// whatever the number of threads.
 void base_fwd_cpu(BaseFwdArgs a, CpuRasterScratch& scratch);
 void base_fwd_cuda(BaseFwdArgs a);
 void base_bwd_cpu(BaseBwdArgs a, CpuRasterScratch& scratch);
 void base_bwd_cuda(BaseBwdArgs a);
-void refl_fwd_cpu(ReflFwdArgs a);
+void refl_fwd_cpu(ReflFwdArgs a, CpuRasterScratch& scratch);
 void refl_fwd_cuda(ReflFwdArgs a);
 void refl_bwd_cpu(ReflBwdArgs a, CpuRasterScratch& scratch);
 void refl_bwd_cuda(ReflBwdArgs a);

@@ -213,7 +213,7 @@ void Renderer::reflection_forward(const kernel::View& view, const DeviceImage<in
     const auto mode = params_.variant == ReflectionVariant::Grouped ? kernel::PlaneMode::Match : kernel::PlaneMode::All;
     kernel::ReflFwdArgs a{view, splats, refl_.bins.views(), set.plane_ids(), I.view(), mode, 0,
                           out.C_r.view(), out.W_r.view(), stop_mean};
-    RRG_DISPATCH(device_, kernel::refl_fwd_cpu(a), kernel::refl_fwd_cuda(a));
+    RRG_DISPATCH(device_, kernel::refl_fwd_cpu(a, refl_.cpu), kernel::refl_fwd_cuda(a));
     return;
   }
   // Multi-pass: every group rendered alone over the whole image, then kept where I(u) == group.
@@ -227,7 +227,7 @@ void Renderer::reflection_forward(const kernel::View& view, const DeviceImage<in
     refl_entries_ += refl_.bins.entries();
     kernel::ReflFwdArgs a{view, splats, refl_.bins.views(), set.plane_ids(), I.view(), kernel::PlaneMode::All, k,
                           group_C_.view(), group_W_.view(), stop_mean};
-    RRG_DISPATCH(device_, kernel::refl_fwd_cpu(a), kernel::refl_fwd_cuda(a));
+    RRG_DISPATCH(device_, kernel::refl_fwd_cpu(a, refl_.cpu), kernel::refl_fwd_cuda(a));
     RRG_DISPATCH(device_,
                  kernel::mask_group_cpu(I.view(), k, group_C_.view(), group_W_.view(), out.C_r.view(), out.W_r.view()),
                  kernel::mask_group_cuda(I.view(), k, group_C_.view(), group_W_.view(), out.C_r.view(), out.W_r.view()));

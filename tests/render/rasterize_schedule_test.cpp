@@ -280,7 +280,8 @@ TEST_P(ReflSchedule, ReflectionPassMatchesThePerPixelLoop) {
   std::vector<Eigen::Vector3f> C_tiled(n), C_pixel(n);
   std::vector<float> W_tiled(n), W_pixel(n);
   ReflFwdArgs a = refl_fwd_args(sc, GetParam(), C_tiled, W_tiled);
-  refl_fwd_cpu(a);
+  CpuRasterScratch scratch = poisoned_scratch(sc);
+  refl_fwd_cpu(a, scratch);
   a.C_r = img(C_pixel, sc);
   a.W_r = img(W_pixel, sc);
   refl_fwd(CpuBackend{}, a);
@@ -294,8 +295,11 @@ TEST_P(ReflSchedule, ReflectionPassMatchesThePerPixelLoop) {
 
   std::vector<SplatGrad> g_tiled(sc.splats.size()), g_pixel(sc.splats.size());
   ReflBwdArgs b = refl_bwd_args(sc, GetParam(), C_pixel, W_pixel, g_tiled);
-  CpuRasterScratch scratch = poisoned_scratch(sc);
-  refl_bwd_cpu(b, scratch);
+  {
+    CpuRasterScratch fresh;  // no forward pass in it
+    EXPECT_THROW(refl_bwd_cpu(b, fresh), std::logic_error);
+  }
+  refl_bwd_cpu(b, scratch);  // the reach of the tiled forward above
   b.v_splats = {g_pixel.data(), int64_t(g_pixel.size())};
   refl_bwd(CpuBackend{}, b);
   int nonzero = 0;
@@ -335,7 +339,10 @@ TEST(RasterizeSchedule, BackwardGradientsDoNotDependOnTheThreadCount) {
   }
   std::vector<Eigen::Vector3f> C_r(n);
   std::vector<float> W_r(n);
-  refl_fwd_cpu(refl_fwd_args(sc, PlaneMode::Match, C_r, W_r));
+  {
+    CpuRasterScratch unused;
+    refl_fwd_cpu(refl_fwd_args(sc, PlaneMode::Match, C_r, W_r), unused);
+  }
 
   const auto backward = [&](int64_t max_kept_pairs = kMaxKeptPairs) {
     std::vector<SplatGrad> base(sc.splats.size(), SplatGrad{}), refl(sc.splats.size(), SplatGrad{});
@@ -345,7 +352,11 @@ TEST(RasterizeSchedule, BackwardGradientsDoNotDependOnTheThreadCount) {
     base_fwd_cpu(base_fwd_args(sc, again), scratch);  // on this thread count too
     EXPECT_EQ(std::memcmp(again.C_b.data(), fwd.C_b.data(), n * sizeof(Eigen::Vector3f)), 0);
     base_bwd_cpu(base_bwd_args(sc, fwd, base), scratch);
-    // the same scratch again: it must not carry pass 2's entries
+    // pass 3 in the same scratch: its backward must not carry pass 2's entries
+    std::vector<Eigen::Vector3f> C_again(n);
+    std::vector<float> W_again(n);
+    refl_fwd_cpu(refl_fwd_args(sc, PlaneMode::Match, C_again, W_again), scratch);
+    EXPECT_EQ(std::memcmp(C_again.data(), C_r.data(), n * sizeof(Eigen::Vector3f)), 0);
     refl_bwd_cpu(refl_bwd_args(sc, PlaneMode::Match, C_r, W_r, refl), scratch);
     return std::pair{base, refl};
   };
