@@ -75,6 +75,8 @@ struct RunMetrics {
 struct RunTimings {
   StageTimes mean;                 // per frame, over frames
   double mapping_step_ms = 0;      // per mapping step (on the mapping thread unless sync)
+  // Its stages per step: keyframe raycasts, densification, optimisation, pruning.
+  double mapping_raycast_ms = 0, mapping_densify_ms = 0, mapping_optimise_ms = 0, mapping_prune_ms = 0;
   int64_t mapping_steps = 0;
   double load_ms = 0;              // dataset reading, per frame
   double premapping_ms = 0;        // raycast + preprocess + icp + orb + fuse + identify, per frame

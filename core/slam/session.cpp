@@ -199,6 +199,10 @@ void Session::Impl::schedule_mapping(FrameReport& report) {
     std::lock_guard lock(state_mutex);
     ++mapping.steps;
     mapping.ms_total += s.ms_total;
+    mapping.ms_raycast += s.ms_raycast;
+    mapping.ms_densify += s.ms_densify;
+    mapping.ms_optimise += s.ms_optimise;
+    mapping.ms_prune += s.ms_prune;
     mapping.last_loss = s.loss;
     mapping.base_gaussians = int64_t(mapper.snapshot() ? mapper.snapshot()->base.size() : 0);
     mapping.reflection_gaussians = int64_t(mapper.snapshot() ? mapper.snapshot()->reflection.size() : 0);

@@ -84,6 +84,9 @@ struct MappingSummary {
   int64_t steps = 0;
   int64_t base_gaussians = 0, reflection_gaussians = 0;
   double ms_total = 0;             // summed over steps
+  // Its stages, summed over steps (MappingStats): the keyframes' TSDF raycasts, densification,
+  // the Adam iterations, pruning.
+  double ms_raycast = 0, ms_densify = 0, ms_optimise = 0, ms_prune = 0;
   double last_loss = 0;
 };
 

@@ -29,6 +29,20 @@ TEST(RunCli, WritesOutputsAndScoresGeometryOnTheObservedSurface) {
   for (const char* f : {"trajectory.txt", "mesh.ply", "mesh.drc", "metrics.json", "timings.json", "config.yaml"})
     EXPECT_TRUE(std::filesystem::exists(out / f)) << f;
 
+  // The mapping step's stages are reported, and they are parts of the step.
+  const auto t = nlohmann::json::parse(std::ifstream(out / "timings.json"));
+  ASSERT_GT(t.at("mapping_steps").get<int>(), 0) << t.dump(2);
+  double stages = 0;
+  for (const char* k : {"mapping_raycast_per_step", "mapping_densify_per_step", "mapping_optimise_per_step",
+                        "mapping_prune_per_step"}) {
+    ASSERT_TRUE(t.contains(k)) << k;
+    EXPECT_GE(t.at(k).get<double>(), 0.0) << k;
+    stages += t.at(k).get<double>();
+  }
+  EXPECT_GT(t.at("mapping_optimise_per_step").get<double>(), 0.0) << t.dump(2);
+  EXPECT_LE(stages, t.at("mapping_step_per_step").get<double>() * 1.0001 + 1e-6) << t.dump(2);
+  EXPECT_NE(r.output.find("optimise"), std::string::npos) << r.output;
+
   const auto j = nlohmann::json::parse(std::ifstream(out / "metrics.json"));
   ASSERT_TRUE(j.contains("geometry")) << j.dump(2);
   const auto& g = j["geometry"];
