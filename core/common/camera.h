@@ -6,6 +6,15 @@
 #include <Eigen/Core>
 #include <string>
 
+// One layout of Eigen's fixed-size types in every object: the C++ code is built with AVX2
+// (RRG_CPU_ARCH, cmake/cpu_arch.cmake), nvcc's host and device passes and Debian's libraries
+// without, and Eigen would align 32-byte types (Matrix4f, Vector4d, Isometry3f) to 32 with AVX and
+// to 16 without, so a struct holding one would differ between a .cpp and a .cu (kernel arguments)
+// or a library. EIGEN_MAX_STATIC_ALIGN_BYTES=16 (set for the C++ code by cmake/cpu_arch.cmake)
+// keeps the 16 of the SSE2 baseline; AVX loads of them are then unaligned ones.
+static_assert(alignof(Eigen::Matrix4f) == 16 && alignof(Eigen::Vector4d) == 16,
+              "Eigen's static alignment differs from the SSE2 baseline: see cmake/cpu_arch.cmake");
+
 namespace rrg {
 
 struct Intrinsics {
