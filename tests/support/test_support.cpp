@@ -37,8 +37,10 @@ std::string rrg_command(const std::string& args) {
 }
 }  // namespace
 
-CommandResult run_rrg(const std::string& args) {
-  const std::string cmd = rrg_command(args) + " 2>&1";
+CommandResult run_rrg(const std::string& args) { return run_shell(rrg_command(args)); }
+
+CommandResult run_shell(const std::string& command) {
+  const std::string cmd = command + " 2>&1";
   FILE* pipe = ::popen(cmd.c_str(), "r");
   if (!pipe) throw std::runtime_error("popen failed for: " + cmd);
   CommandResult result;
