@@ -29,8 +29,8 @@ void write_stderr(const char* s) {
   if (ok) return;
   write_stderr("error: this program was built for ");
   write_stderr(level);
-  write_stderr(" CPUs (AVX2, FMA; cmake/cpu_arch.cmake) and this CPU lacks that instruction set. "
-               "Rebuild with -DRRG_CPU_ARCH= (the compiler's default) or -DRRG_CPU_ARCH=native.\n");
+  write_stderr(" CPUs (-march, cmake/cpu_arch.cmake; x86-64-v3 means AVX2 and FMA) and this CPU lacks that "
+               "instruction set. Rebuild with -DRRG_CPU_ARCH= (the compiler's default) or -DRRG_CPU_ARCH=native.\n");
   _exit(70);  // EX_SOFTWARE
 }
 
