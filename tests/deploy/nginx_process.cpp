@@ -10,7 +10,6 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <array>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -56,16 +55,6 @@ std::string find_nginx() {
     if (fs::exists(p)) return p;
   const auto [rc, out] = run_shell("command -v nginx");
   return rc == 0 ? out.substr(0, out.find('\n')) : "";
-}
-
-std::pair<int, std::string> run_shell(const std::string& command) {
-  FILE* p = ::popen((command + " 2>&1").c_str(), "r");
-  if (!p) throw std::runtime_error("cannot run: " + command);
-  std::string out;
-  std::array<char, 4096> buf;
-  while (size_t n = std::fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
-  const int status = ::pclose(p);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : 128, out};
 }
 
 int free_port() {

@@ -2,6 +2,8 @@
 // Debian's nginx as a test process: run as the current user with its own prefix, config, pid,
 // logs and temp folders in a scratch directory, from the template deploy/nginx/rrg-local.conf.in
 // (a gRPC proxy hashing on x-rrg-session over a list of upstream servers).
+#include "tests/support/test_support.h"  // run_shell
+
 #include <sys/types.h>
 
 #include <filesystem>
@@ -15,8 +17,6 @@ std::string find_nginx();
 // deploy/nginx/rrg-local.conf.in with its placeholders filled.
 std::string render_nginx_conf(const std::filesystem::path& prefix, const std::string& listen,
                               const std::vector<std::string>& servers);
-// Runs a command through the shell; returns {exit code, stdout + stderr}.
-std::pair<int, std::string> run_shell(const std::string& command);
 // A free loopback TCP port (bound and released; nginx cannot write a port file).
 int free_port();
 

@@ -25,7 +25,8 @@ struct CommandResult {
 };
 // Runs `rrg <args>` (the freshly built binary) through the shell and captures its output.
 CommandResult run_rrg(const std::string& args);
-// Runs a shell command line and captures its output the same way.
+// Runs a shell command line and captures its output the same way (exit code −1 when a signal
+// ended it); `auto [rc, out] = run_shell(...)` reads both.
 CommandResult run_shell(const std::string& command);
 
 // `rrg <args>` started in the background (stdout and stderr to `log`), for tests that signal it.
