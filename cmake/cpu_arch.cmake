@@ -32,8 +32,8 @@ endif()
 # context an inlined expression lands in: the same source line then rounds differently in two places
 # (the renderer's backward recomputing the forward's falloffs, rasterize_schedule_test.cpp), and
 # the CPU back end is the oracle. Results of an x86-64-v3 build still differ from the baseline
-# build's in the last bits (Eigen's wider packets sum in another order), not between runs or thread
-# counts of one build.
+# build's in the last bits (probably Eigen's wider packets summing in another order), not between
+# runs or thread counts of one build.
 add_compile_options($<$<COMPILE_LANGUAGE:CXX>:-ffp-contract=off>)
 
 # The start-up check, compiled for the baseline so that it can run on any CPU. Every program links
