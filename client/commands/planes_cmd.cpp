@@ -150,10 +150,17 @@ void run_eval(const EvalOptions& o) {
                          {"accepted", c.reflective.accepted}, {"accepted_correct", c.reflective.accepted_correct},
                          {"gt_reflective", c.reflective.gt_reflective}, {"gt_found", c.reflective.gt_found},
                          {"accepted_planes", c.reflective.accepted_names}, {"missed_planes", c.reflective.missed_names},
+                         {"gt_verifiable", c.gt_verifiable}, {"gt_verifiable_found", c.gt_verifiable_found},
+                         {"verifiable_recall", c.verifiable_recall()},
                          {"mask_iou", c.mean_mask_iou},
                          {"ms", {{"segment", c.mean_ms.segment_ms}, {"associate", c.mean_ms.associate_ms},
                                  {"semantic", c.mean_ms.semantic_ms}, {"verify", c.mean_ms.verify_ms},
                                  {"identify", c.mean_ms.total_ms}}}});
+  j["observed_variance"] = nlohmann::json::array();
+  for (const auto& ob : r.observed)
+    j["observed_variance"].push_back({{"id", ob.id}, {"name", ob.name}, {"points", ob.variance.points},
+                                      {"fraction_above", ob.variance.fraction_above}, {"median", ob.variance.median},
+                                      {"verifiable", ob.verifiable}});
   if (r.interrupted) j["interrupted"] = true;
   if (o.json) {
     std::cout << j.dump(1) << "\n";
@@ -175,12 +182,23 @@ void run_eval(const EvalOptions& o) {
     }
     std::printf("  unstable GT plane %d: global id:frames%s\n", g, ids.c_str());
   }
+  std::printf("variance the input shows on reflective GT planes (identification frames, ground truth; "
+              "verifiable: > %.3g of the points above %.3g):\n", e.params.area_threshold, e.params.variance_threshold);
+  for (const auto& ob : r.observed)
+    std::printf("  %-24s GT %3d: %.3f of %lld points above, median %.4f%s\n", ob.name.c_str(), ob.id,
+                ob.variance.fraction_above, (long long)ob.variance.points, ob.variance.median,
+                ob.verifiable ? "" : "  (not verifiable)");
   for (const auto& c : r.cues) {
     std::printf("semantics %-7s reflective planes: precision %.3f (%d/%d) recall %.3f (%d/%d), mask IoU %.3f\n",
                 c.semantics.c_str(), c.reflective.precision(), c.reflective.accepted_correct, c.reflective.accepted,
                 c.reflective.recall(), c.reflective.gt_found, c.reflective.gt_reflective, c.mean_mask_iou);
     for (const auto& n : c.reflective.accepted_names) std::printf("  accepted: %s\n", n.c_str());
     for (const auto& n : c.reflective.missed_names) std::printf("  missed:   %s\n", n.c_str());
+    if (c.gt_verifiable > 0)
+      std::printf("  recall over the verifiable planes: %.3f (%d/%d)\n", c.verifiable_recall(), c.gt_verifiable_found,
+                  c.gt_verifiable);
+    else
+      std::printf("  recall over the verifiable planes: none of the %d is verifiable\n", c.reflective.gt_reflective);
     std::printf("  ms per step: segment %.2f associate %.2f semantic %.2f verify %.2f identify %.2f\n", c.mean_ms.segment_ms,
                 c.mean_ms.associate_ms, c.mean_ms.semantic_ms, c.mean_ms.verify_ms, c.mean_ms.total_ms);
   }

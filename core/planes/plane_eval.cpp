@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <chrono>
 #include <optional>
+#include <set>
 #include <stdexcept>
 
 namespace rrg {
@@ -86,6 +87,7 @@ PlaneEvalReport run_plane_eval(const PlaneEvalOptions& options) {
   std::optional<TsdfVolume> volume;
   if (options.fuse) volume.emplace(tp, options.device);
 
+  ObservedVariance observed(K, tp.truncation);
   PlaneEvalReport report;
   double fuse_ms = 0, raycast_ms = 0;
   size_t raycasts = 0;
@@ -109,6 +111,7 @@ PlaneEvalReport run_plane_eval(const PlaneEvalOptions& options) {
       if (needs_labels) labels = io::read_synth_labels(options.dataset, k);
       const LabelImage gt = io::read_synth_planes(options.dataset, k);
       const MaskImage gt_reflection = io::read_synth_reflection(options.dataset, k);
+      observed.add(T_wc, frame.depth, frame.color, gt);
       IdentificationFrame f{&frame.depth, &frame.color, needs_labels ? &labels : nullptr, K, T_wc, int64_t(k),
                             options.fuse ? options.voxel_size : 0.0f};
       for (size_t c = 0; c < identifiers.size(); ++c) {
@@ -155,11 +158,23 @@ PlaneEvalReport run_plane_eval(const PlaneEvalOptions& options) {
   report.raycast_ms = raycasts > 0 ? raycast_ms / double(raycasts) : 0;
   report.global_planes = int(identifiers[0].table().live_ids().size());
   report.ids = scorers[0].id_stability(identifiers[0].table().remap_table());
+  std::set<int> reflective_ids;
+  for (const auto& [id, g] : gt_planes)
+    if (g.reflective) reflective_ids.insert(id);
+  const auto shown = observed.stats(reflective_ids, options.params.variance_threshold);
+  for (const auto& [id, v] : shown)
+    report.observed.push_back({id, gt_planes.at(id).name, v, v.verifiable(options.params.area_threshold)});
   for (size_t c = 0; c < identifiers.size(); ++c) {
     PlaneEvalCueReport cr;
     cr.semantics = options.semantics[c];
     cr.reflective = scorers[c].reflective(identifiers[c].table().remap_table(), identifiers[c].vote().lookup_table(),
                                           gt_planes, options.params.vote.min_reflective);
+    for (const auto& [id, found] : cr.reflective.counted) {
+      const auto o = shown.find(id);
+      if (o == shown.end() || !o->second.verifiable(options.params.area_threshold)) continue;
+      ++cr.gt_verifiable;
+      cr.gt_verifiable_found += found ? 1 : 0;
+    }
     cr.mean_ms = divided(time_sums[c], double(report.windows));
     cr.mean_mask_iou = iou_counts[c] > 0 ? iou_sums[c] / iou_counts[c] : 0.0;
     report.cues.push_back(cr);

@@ -6,6 +6,7 @@
 // predicted reflection mask back into fusion as the ReflectionObservation of that frame. Scores
 // segmentation, id stability and reflective identification against planes/ and planes.json.
 #include "core/common/device.h"
+#include "core/planes/observed_variance.h"
 #include "core/planes/plane_identification.h"
 #include "core/planes/plane_metrics.h"
 #include "core/planes/remote_segmenter.h"
@@ -35,6 +36,10 @@ struct PlaneEvalOptions {
 struct PlaneEvalCueReport {
   std::string semantics;
   ReflectiveScores reflective;
+  // Recall over the reflective GT planes that count for `reflective.recall()` and whose input shows
+  // the variance the check needs (PlaneEvalReport::observed): found / verifiable.
+  int gt_verifiable = 0, gt_verifiable_found = 0;
+  double verifiable_recall() const { return gt_verifiable > 0 ? double(gt_verifiable_found) / gt_verifiable : 1.0; }
   IdentificationTimings mean_ms;   // per identification step
   double mean_mask_iou = 0;        // predicted reflection mask vs GT reflection mask, mean over steps with either non-empty
 };
@@ -45,6 +50,16 @@ struct PlaneEvalReport {
   SegmentationCounts segmentation;  // over identification frames (first cue's segmentation)
   IdStability ids;
   std::vector<PlaneEvalCueReport> cues;
+  // Per reflective GT plane seen in the identification frames: the temporal variance its input
+  // shows (core/planes/observed_variance.h, δ_v and δ_area of the params, depth tolerance = the TSDF
+  // truncation), and whether it is verifiable (fraction above δ_v > δ_area).
+  struct Observed {
+    int id = 0;
+    std::string name;
+    PlaneObservedVariance variance;
+    bool verifiable = false;
+  };
+  std::vector<Observed> observed;
   int global_planes = 0;            // live instances at the end
   double fuse_ms = 0, raycast_ms = 0;  // means per fused frame / per raycast
 };

@@ -227,6 +227,7 @@ ReflectiveScores IdentificationScorer::reflective(const std::vector<int32_t>& re
     const auto it = by_gt.find(g);
     const bool found = it != by_gt.end() && accepted_canon.count(majority_key(it->second)) > 0;
     s.gt_found += found ? 1 : 0;
+    s.counted[g] = found;
     if (!found) s.missed_names.push_back(gp->second.name);
   }
   return s;

@@ -68,6 +68,7 @@ struct ReflectiveScores {
   int gt_reflective = 0, gt_found = 0;     // reflective GT planes seen enough; found
   std::vector<std::string> accepted_names; // majority GT plane name of each accepted plane
   std::vector<std::string> missed_names;
+  std::map<int, bool> counted;             // GT id of each reflective plane counted for recall -> found
   double precision() const { return accepted > 0 ? double(accepted_correct) / double(accepted) : 1.0; }
   double recall() const { return gt_reflective > 0 ? double(gt_found) / double(gt_reflective) : 1.0; }
 };

@@ -77,6 +77,20 @@ TEST_F(PlanesCli, EvalRunsBothCuesWithFusion) {
   EXPECT_GT(j["global_planes"].get<int>(), 2);
   // Three windows are fewer than the four reflective votes L_ref needs.
   EXPECT_EQ(j["cues"][1]["accepted"].get<int>(), 0);
+  // The variance the input shows on the reflective GT planes it saw: the glossy floor among them,
+  // with its points and a fraction in [0, 1]; recall over the verifiable ones beside the plain one.
+  ASSERT_TRUE(j["observed_variance"].is_array());
+  bool floor = false;
+  for (const auto& o : j["observed_variance"]) {
+    EXPECT_GT(o["points"].get<int64_t>(), 0);
+    EXPECT_GE(o["fraction_above"].get<double>(), 0.0);
+    EXPECT_LE(o["fraction_above"].get<double>(), 1.0);
+    EXPECT_EQ(o["verifiable"].get<bool>(), o["fraction_above"].get<double>() > 0.05);
+    floor = floor || o["name"] == "floor";
+  }
+  EXPECT_TRUE(floor) << j["observed_variance"].dump();
+  EXPECT_LE(j["cues"][0]["gt_verifiable"].get<int>(), j["cues"][0]["gt_reflective"].get<int>());
+  EXPECT_TRUE(j["cues"][0].contains("verifiable_recall"));
 }
 
 TEST_F(PlanesCli, ErrorsAndUsage) {
