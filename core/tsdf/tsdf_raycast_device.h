@@ -45,74 +45,106 @@ RRG_HD inline float block_exit(const Eigen::Vector3f& p, const Eigen::Vector3f& 
 //                                                into the band behind it (f ≥ −1), where the crossing
 //                                                is still bracketed (as Open3D's march steps);
 //   f ≤ 0 without a positive sample before    → one voxel (entering from behind a surface).
+// One ray's march as a state machine: march_begin() sets it up, each march_step() takes one
+// sample (a crossing's refinement included) and returns true when the ray is done (s.hit says how).
+// march() runs one ray to the end; the CPU raycast interleaves the steps of a few rays instead, so
+// that the core overlaps their dependent chains of loads (tsdf_raycast_impl.h). Either way each ray
+// takes the same samples and gives the same hit.
+struct MarchState {
+  Eigen::Vector3f o, d, inv_d;
+  float len, voxel_z, nudge_z, truncation, z_end;
+  float z, z_prev = 0.0f, f_prev = 0.0f;
+  bool have_prev = false;
+  RayHit hit;
+};
+
+RRG_HD RRG_INLINE void march_begin(MarchState& m, const VolumeView& vol, const Eigen::Vector3f& o, const Eigen::Vector3f& d,
+                                   float truncation, float z_start, float z_end) {
+  m.o = o;
+  m.d = d;
+  m.len = d.norm();  // metres per unit of z
+  m.inv_d = Eigen::Vector3f(1.0f / d.x(), 1.0f / d.y(), 1.0f / d.z());
+  m.voxel_z = vol.voxel_size / m.len;          // one voxel along the ray
+  m.nudge_z = 1e-3f * vol.voxel_size / m.len;  // 1/1000 voxel along the ray
+  m.truncation = truncation;
+  m.z_end = z_end;
+  m.z = z_start;
+  m.z_prev = 0.0f;
+  m.f_prev = 0.0f;
+  m.have_prev = false;
+  m.hit = RayHit{};
+}
+
+RRG_TU_LOCAL RRG_HD inline bool march_step(const VolumeView& vol, MarchState& m, BlockCache& cache) {
+  if (!(m.z < m.z_end)) return true;
+  const float s = vol.voxel_size;
+  const Eigen::Vector3f& d = m.d;
+  const Eigen::Vector3f p = m.o + m.z * d;
+  Corners corners;
+  const Sample sample = trilinear_corners(vol, p, cache, corners);
+  if (sample == Sample::NoBlock) {  // empty space: skip the whole block
+    m.z += block_exit(p, d, m.inv_d, corners.block, s) + m.nudge_z;
+    m.have_prev = false;
+    return false;
+  }
+  if (sample == Sample::Unobserved) {
+    // No corner of the cell observed: every cell sharing one of its corners is invalid too, so
+    // no valid sample lies in the box g − 1 .. g + 2 (voxel units) around it; skip to its exit,
+    // which is at least one voxel away. Otherwise one voxel.
+    float step = m.voxel_z;
+    if (corners.missing == 8) {
+      step = 1e30f;
+      for (int k = 0; k < 3; ++k)
+        if (d[k] != 0.0f) step = min_f(step, (d[k] > 0.0f ? 2.0f - corners.f[k] : 1.0f + corners.f[k]) * s * fabsf(m.inv_d[k]));
+    }
+    m.z += step;
+    m.have_prev = false;
+    return false;
+  }
+  const float f = trilinear(corners.t, corners.f) * voxel_codec::kInvTsdfScale;
+  if (m.have_prev && m.f_prev > 0.0f && f <= 0.0f) {
+    // Regula falsi with the Illinois modification on the bracket [z_prev, z]: the trilinear TSDF
+    // is cubic along the ray, so plain secant steps can stall on one side of a large bracket.
+    float za = m.z_prev, fa = m.f_prev, zb = m.z, fb = f;
+    float zc = za + (zb - za) * fa / (fa - fb);
+    int side = 0;
+    for (int it = 0; it < kRefineSteps && (zb - za) * m.len > kRefineTol * s; ++it) {
+      float fc;
+      if (!sample_tsdf(vol, m.o + zc * d, cache, fc)) break;
+      if (fabsf(fc) * m.truncation <= kRefineTol * s) break;  // |d| bounds the distance to the surface
+      if (fc > 0.0f) {
+        za = zc;
+        fa = fc;
+        if (side == 1) fb *= 0.5f;
+        side = 1;
+      } else {
+        zb = zc;
+        fb = fc;
+        if (side == -1) fa *= 0.5f;
+        side = -1;
+      }
+      if (fa - fb <= 0.0f) break;
+      zc = za + (zb - za) * fa / (fa - fb);
+    }
+    m.hit.hit = true;
+    m.hit.z = zc;
+    m.hit.p_w = m.o + zc * d;
+    return true;
+  }
+  m.have_prev = true;
+  m.z_prev = m.z;
+  m.f_prev = f;
+  m.z += f > 0.0f ? max_f(m.voxel_z, f * m.truncation / m.len) : m.voxel_z;
+  return false;
+}
+
 RRG_TU_LOCAL RRG_HD inline RayHit march(const VolumeView& vol, const Eigen::Vector3f& o, const Eigen::Vector3f& d,
                            float truncation, float z_start, float z_end, BlockCache& cache) {
-  RayHit hit;
-  const float len = d.norm();           // metres per unit of z
-  const float s = vol.voxel_size;
-  const Eigen::Vector3f inv_d(1.0f / d.x(), 1.0f / d.y(), 1.0f / d.z());
-  const float voxel_z = s / len, nudge_z = 1e-3f * s / len;  // one voxel, 1/1000 voxel along the ray
-  float z = z_start, z_prev = 0.0f, f_prev = 0.0f;
-  bool have_prev = false;
-  while (z < z_end) {
-    const Eigen::Vector3f p = o + z * d;
-    Corners corners;
-    const Sample sample = trilinear_corners(vol, p, cache, corners);
-    if (sample == Sample::NoBlock) {  // empty space: skip the whole block
-      z += block_exit(p, d, inv_d, corners.block, s) + nudge_z;
-      have_prev = false;
-      continue;
-    }
-    if (sample == Sample::Unobserved) {
-      // No corner of the cell observed: every cell sharing one of its corners is invalid too, so
-      // no valid sample lies in the box g − 1 .. g + 2 (voxel units) around it; skip to its exit,
-      // which is at least one voxel away. Otherwise one voxel.
-      float step = voxel_z;
-      if (corners.missing == 8) {
-        step = 1e30f;
-        for (int k = 0; k < 3; ++k)
-          if (d[k] != 0.0f) step = min_f(step, (d[k] > 0.0f ? 2.0f - corners.f[k] : 1.0f + corners.f[k]) * s * fabsf(inv_d[k]));
-      }
-      z += step;
-      have_prev = false;
-      continue;
-    }
-    const float f = trilinear(corners.t, corners.f) * voxel_codec::kInvTsdfScale;
-    if (have_prev && f_prev > 0.0f && f <= 0.0f) {
-      // Regula falsi with the Illinois modification on the bracket [z_prev, z]: the trilinear TSDF
-      // is cubic along the ray, so plain secant steps can stall on one side of a large bracket.
-      float za = z_prev, fa = f_prev, zb = z, fb = f;
-      float zc = za + (zb - za) * fa / (fa - fb);
-      int side = 0;
-      for (int it = 0; it < kRefineSteps && (zb - za) * len > kRefineTol * s; ++it) {
-        float fc;
-        if (!sample_tsdf(vol, o + zc * d, cache, fc)) break;
-        if (fabsf(fc) * truncation <= kRefineTol * s) break;  // |d| bounds the distance to the surface
-        if (fc > 0.0f) {
-          za = zc;
-          fa = fc;
-          if (side == 1) fb *= 0.5f;
-          side = 1;
-        } else {
-          zb = zc;
-          fb = fc;
-          if (side == -1) fa *= 0.5f;
-          side = -1;
-        }
-        if (fa - fb <= 0.0f) break;
-        zc = za + (zb - za) * fa / (fa - fb);
-      }
-      hit.hit = true;
-      hit.z = zc;
-      hit.p_w = o + zc * d;
-      return hit;
-    }
-    have_prev = true;
-    z_prev = z;
-    f_prev = f;
-    z += f > 0.0f ? max_f(voxel_z, f * truncation / len) : voxel_z;
+  MarchState m;
+  march_begin(m, vol, o, d, truncation, z_start, z_end);
+  while (!march_step(vol, m, cache)) {
   }
-  return hit;
+  return m.hit;
 }
 
 struct SurfaceSample {

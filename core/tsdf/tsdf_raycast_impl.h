@@ -5,6 +5,8 @@
 #include "core/tsdf/tsdf_range_device.h"
 #include "core/tsdf/tsdf_raycast_device.h"
 
+#include <type_traits>
+
 namespace rrg::kernel {
 
 struct RaycastArgs {
@@ -36,8 +38,10 @@ struct RaycastRun<CpuBackend> {
   static constexpr int value = kRangeTile;
 };
 
+enum class PixelRay { Outside, Miss, March };  // past the image edge; no block in range; a ray to march
+
 // Three passes: clear the range image, splat every resident block into it, march every pixel
-// within its tile's [near, far] (tsdf_range_device.h).
+// within its tile's [near, far] (tsdf_range_device.h), then shade it.
 template <class Backend>
 void raycast(Backend backend, const RaycastArgs& a) {
   const RaycastArgs args = a;
@@ -57,39 +61,95 @@ void raycast(Backend backend, const RaycastArgs& a) {
   const int h = a.depth.height;
   constexpr int run = RaycastRun<Backend>::value;
   const int64_t tile_px = int64_t(kRangeTile) * kRangeTile;
-  parallel_for(backend, int64_t(a.range.tiles_x) * a.range.tiles_y * tile_px / run, [=] RRG_HD(int64_t item) {
-    BlockCache cache;
-    for (int r = 0; r < run; ++r) {
-      const int64_t j = item * run + r;
-      const int64_t t = j / tile_px, k = j % tile_px;
-      const int xi = int(t % args.range.tiles_x) * kRangeTile + int(k % kRangeTile);
-      const int yi = int(t / args.range.tiles_x) * kRangeTile + int(k / kRangeTile);
-      if (xi >= w || yi >= h) continue;
-      const int64_t i = int64_t(yi) * w + xi;
-      float near, far;
-      range_at(args.range, xi, yi, near, far);
-      const Eigen::Vector3f d = args.R_wc * args.K.unproject(float(xi), float(yi), 1.0f);
-      RayHit hit;
-      if (near <= far)  // a little slack on the far end for rounding in the splat
-        hit = march(args.volume, args.t_wc, d, args.truncation, max_f(near, args.min_depth),
-                    min_f(far + 0.01f * args.volume.voxel_size, args.max_depth), cache);
-      SurfaceSample s;
-      if (hit.hit)
-        s = shade(args.volume, hit.p_w, args.remap, cache, args.want_color, args.want_reflection, args.want_normals);
-      args.depth[i] = hit.hit ? hit.z : 0.0f;
-      if (args.want_normals) {
-        args.vertices[i] = hit.p_w;
-        args.normals[i] = s.normal;
-      }
-      if (args.want_color) args.colors[i] = s.color;
-      if (args.want_reflection) {
-        args.plane_ids[i] = s.plane;
-        args.reflection[i] = s.reflection;
-        args.mask[i] = s.reflection > 0.5f ? 1 : 0;
-        args.variance[i] = s.variance;
-      }
+  const auto write = [=] RRG_HD(int64_t i, const RayHit& hit, BlockCache& cache) {
+    SurfaceSample s;
+    if (hit.hit)
+      s = shade(args.volume, hit.p_w, args.remap, cache, args.want_color, args.want_reflection, args.want_normals);
+    args.depth[i] = hit.hit ? hit.z : 0.0f;
+    if (args.want_normals) {
+      args.vertices[i] = hit.p_w;
+      args.normals[i] = s.normal;
     }
-  });
+    if (args.want_color) args.colors[i] = s.color;
+    if (args.want_reflection) {
+      args.plane_ids[i] = s.plane;
+      args.reflection[i] = s.reflection;
+      args.mask[i] = s.reflection > 0.5f ? 1 : 0;
+      args.variance[i] = s.variance;
+    }
+  };
+  // Pixel j of the tile-ordered numbering: its image index i, and its ray set up in m when its range
+  // tile holds a block (a little slack on the far end for rounding in the splat).
+  const auto setup = [=] RRG_HD(int64_t j, int64_t& i, MarchState& m) {
+    const int64_t t = j / tile_px, k = j % tile_px;
+    const int xi = int(t % args.range.tiles_x) * kRangeTile + int(k % kRangeTile);
+    const int yi = int(t / args.range.tiles_x) * kRangeTile + int(k / kRangeTile);
+    if (xi >= w || yi >= h) return PixelRay::Outside;
+    i = int64_t(yi) * w + xi;
+    float near, far;
+    range_at(args.range, xi, yi, near, far);
+    if (!(near <= far)) return PixelRay::Miss;
+    const Eigen::Vector3f d = args.R_wc * args.K.unproject(float(xi), float(yi), 1.0f);
+    march_begin(m, args.volume, args.t_wc, d, args.truncation, max_f(near, args.min_depth),
+                min_f(far + 0.01f * args.volume.voxel_size, args.max_depth));
+    return PixelRay::March;
+  };
+  if constexpr (std::is_same_v<Backend, CpuBackend>) {
+    // A CPU thread marches the run's rays kLanes at a time, one sample of each in turn: a ray's
+    // samples form one long chain of dependent loads, and independent chains side by side let the
+    // core overlap them. Each ray takes the same samples as on its own (the block cache only saves
+    // lookups), then its pixel is shaded and written as on the GPU.
+    constexpr int kLanes = 4;
+    parallel_for(backend, int64_t(a.range.tiles_x) * a.range.tiles_y * tile_px / run, [=](int64_t item) {
+      BlockCache cache;
+      int64_t index[run];
+      RayHit hits[run];
+      MarchState lane[kLanes];
+      int ray_of[kLanes];
+      int next = 0, active = 0;
+      const auto refill = [&](int l) {
+        ray_of[l] = -1;
+        while (next < run) {
+          const int r = next++;
+          const PixelRay ray = setup(item * run + r, index[r], lane[l]);
+          if (ray == PixelRay::March) {
+            ray_of[l] = r;
+            ++active;
+            return;
+          }
+          if (ray == PixelRay::Miss) hits[r] = RayHit{};
+          else index[r] = -1;
+        }
+      };
+      for (int l = 0; l < kLanes; ++l) refill(l);
+      while (active > 0)
+        for (int l = 0; l < kLanes; ++l) {
+          if (ray_of[l] < 0 || !march_step(args.volume, lane[l], cache)) continue;
+          hits[ray_of[l]] = lane[l].hit;
+          --active;
+          refill(l);
+        }
+      for (int r = 0; r < run; ++r)
+        if (index[r] >= 0) write(index[r], hits[r], cache);
+    });
+  } else {
+    parallel_for(backend, int64_t(a.range.tiles_x) * a.range.tiles_y * tile_px / run, [=] RRG_HD(int64_t item) {
+      BlockCache cache;
+      for (int r = 0; r < run; ++r) {
+        int64_t i;
+        MarchState m;
+        const PixelRay ray = setup(item * run + r, i, m);
+        if (ray == PixelRay::Outside) continue;
+        RayHit hit;
+        if (ray == PixelRay::March) {
+          while (!march_step(args.volume, m, cache)) {
+          }
+          hit = m.hit;
+        }
+        write(i, hit, cache);
+      }
+    });
+  }
 }
 
 void raycast_cpu(const RaycastArgs& a);
