@@ -3,6 +3,7 @@
 // bisects the first +/− crossing: same hit/miss away from silhouettes, depth within 0.05 voxel.
 #include "core/tsdf/tsdf_range_device.h"
 #include "core/tsdf/tsdf_raycast.h"
+#include "core/tsdf/tsdf_raycast_device.h"
 #include "core/tsdf/tsdf_sample_device.h"
 #include "tests/tsdf/analytic_scene.h"
 
@@ -112,6 +113,48 @@ TEST(TsdfRaycast, FastMarchAgreesWithADenseReferenceMarch) {
     EXPECT_EQ(c.hit_mismatch, 0);
     EXPECT_LT(c.worst_depth, 0.05f * volume.params().voxel_size);
   }
+}
+
+// The CPU raycast keeps several rays in flight per work item, one march_step of each in turn, with
+// one block cache for all of them. Each ray must still end where it ends marching alone: the same
+// hit or miss and the same depth, bit for bit.
+TEST(TsdfRaycast, InterleavedMarchStepsGiveEachRayItsOwnHit) {
+  const test::Scene scene{{{test::Primitive::Sphere, {0, 0, 0}, {0.2f, 0, 0}},
+                           {test::Primitive::Box, {0.25f, 0.1f, 0.1f}, {0.1f, 0.12f, 0.08f}}}};
+  TsdfVolume volume(params_1cm(), Device::cpu());
+  test::fuse_scene(volume, scene, kSmallK, test::cameras_around({0.05f, 0, 0}, 0.9f));
+  const kernel::VolumeView view{volume.hash_view(), volume.geometry(), volume.attributes(), volume.params().voxel_size};
+  const Eigen::Isometry3f T = test::look_at({0.4f, -0.3f, -0.7f}, {0, 0, 0});
+  const float eps = volume.params().truncation, z0 = volume.params().min_depth, z1 = volume.params().max_depth;
+  std::vector<Eigen::Vector3f> dirs;
+  for (int v = 0; v < kSmallK.height; ++v)
+    for (int u = 0; u < kSmallK.width; ++u) dirs.push_back(T.linear() * kSmallK.unproject(float(u), float(v), 1.0f));
+  std::vector<kernel::RayHit> alone(dirs.size());
+  for (size_t r = 0; r < dirs.size(); ++r) {
+    kernel::BlockCache cache;
+    alone[r] = kernel::march(view, T.translation(), dirs[r], eps, z0, z1, cache);
+  }
+  constexpr int kLanes = 4;
+  kernel::BlockCache shared;
+  int hits = 0;
+  for (size_t first = 0; first < dirs.size(); first += kLanes) {
+    kernel::MarchState lane[kLanes];
+    bool done[kLanes] = {};
+    const int n = int(std::min<size_t>(kLanes, dirs.size() - first));
+    for (int l = 0; l < n; ++l) kernel::march_begin(lane[l], view, T.translation(), dirs[first + size_t(l)], eps, z0, z1);
+    for (int left = n; left > 0;)
+      for (int l = 0; l < n; ++l)
+        if (!done[l] && kernel::march_step(view, lane[l], shared)) done[l] = true, --left;
+    for (int l = 0; l < n; ++l) {
+      const kernel::RayHit& a = alone[first + size_t(l)];
+      const kernel::RayHit& b = lane[l].hit;
+      ASSERT_EQ(a.hit, b.hit) << "ray " << first + size_t(l);
+      if (!a.hit) continue;
+      ++hits;
+      EXPECT_EQ(a.z, b.z) << "ray " << first + size_t(l);
+    }
+  }
+  EXPECT_GT(hits, 300);
 }
 
 // A view from far away (every block near the far end of the range) and from inside a sphere shell
