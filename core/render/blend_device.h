@@ -4,6 +4,8 @@
 // copy of the math. Used by the CPU loop and by the CUDA kernels alike.
 #include "core/render/splat.h"
 
+#include <cstring>
+
 namespace rrg::kernel {
 
 inline constexpr float kAlphaMin = 1.0f / 255.0f;    // smaller alphas are skipped (3DGS)
@@ -12,6 +14,41 @@ inline constexpr float kTransmittanceMin = 1e-4f;    // pass 3 stops before T dr
 // Exponents below ln(kAlphaMin) - 1e-3 give alpha < kAlphaMin for any opacity <= 1: rejected
 // before the exp (an exact shortcut, not a new threshold).
 inline constexpr float kPowerMin = -5.5422645f;
+
+// e^x for the falloff, where x = power is in [kPowerMin, 0] (other x are clamped to [-87, 0], which
+// keeps the result a normal float). CUDA: expf. Host: range reduction x = n ln2 + r, |r| <= ln2 / 2
+// (n rounded to nearest by the 1.5 * 2^23 shift, ln2 split in two so that n ln2 is exact), the
+// degree-7 Taylor polynomial of e^r (truncation below r^8 / 8! e^r, about 1e-8 relative), and 2^n
+// set in the exponent bits. Plain arithmetic, so the compiler evaluates eight pixels at once in the
+// CPU rasteriser's lane loops (rasterize_cpu.cpp) with the same result as one at a time (no fused
+// multiply-adds: cmake/cpu_arch.cmake); within 2 ulp of e^x (RasterizeSchedule.FalloffExpIsWithinTwoUlpOfExp).
+RRG_HD RRG_INLINE float falloff_exp(float x) {
+#if defined(__CUDA_ARCH__)
+  return expf(x);
+#else
+  x = x < -87.0f ? -87.0f : (x > 0.0f ? 0.0f : x);
+  constexpr float kShift = 12582912.0f;  // 1.5 * 2^23
+  const float t = x * 1.44269504f + kShift;
+  const float n = t - kShift;  // round(x / ln2)
+  const float r = (x - n * 0.693359375f) + n * 2.12194440e-4f;  // ln2 = 0.693359375 - 2.12194440e-4
+  float p = 1.0f / 5040.0f;
+  p = p * r + 1.0f / 720.0f;
+  p = p * r + 1.0f / 120.0f;
+  p = p * r + 1.0f / 24.0f;
+  p = p * r + 1.0f / 6.0f;
+  p = p * r + 0.5f;
+  p = p * r + 1.0f;
+  p = p * r + 1.0f;
+  constexpr int32_t kShiftBits = 0x4B400000;  // the bits of kShift
+  int32_t ti;
+  std::memcpy(&ti, &t, sizeof ti);
+  const int32_t bits = (ti - kShiftBits + 127) * (int32_t(1) << 23);  // 2^n, n in [-126, 0]
+  float scale;
+  std::memcpy(&scale, &bits, sizeof scale);
+  return p * scale;
+#endif
+}
+RRG_HD RRG_INLINE double falloff_exp(double x) { return k_exp(x); }
 
 // The falloff of splat s at pixel (px, py): offset d = p_hat - u and G = exp(power), with
 // power = -1/2 d^T Sigma'^-1 d. valid is false when the exponent is positive (as in 3DGS) or below
@@ -22,24 +59,47 @@ struct SplatFalloffT {
   bool valid;
 };
 
+// The pieces, on scalars (the CPU forward of pass 2 evaluates them on eight pixels at once):
+// power = -1/2 d^T Sigma'^-1 d at offset d = (dx, dy); whether it gives a falloff; G = exp(power)
+// where it does, else 0; alpha from G.
+template <class T>
+RRG_HD inline T splat_power(const SplatT<T>& s, T dx, T dy) {
+  return T(-0.5) * (s.conic[0] * dx * dx + s.conic[2] * dy * dy) - s.conic[1] * dx * dy;
+}
+
+template <class T>
+RRG_HD inline bool power_valid(T power) {
+  return !((power > T(0)) | (power < T(kPowerMin)));
+}
+
+template <class T>
+RRG_HD inline T power_falloff(T power) {
+  return power_valid(power) ? falloff_exp(power) : T(0);
+}
+
+// alpha_i(u) = min(sigma_i G, alpha_max), or 0 below kAlphaMin, for a valid falloff G.
+template <class T>
+RRG_HD inline T falloff_alpha(T opacity, T G, T alpha_max) {
+  T alpha = opacity * G;
+  alpha = alpha > alpha_max ? alpha_max : alpha;
+  return alpha < T(kAlphaMin) ? T(0) : alpha;
+}
+
 template <class T>
 RRG_HD inline SplatFalloffT<T> splat_falloff(const SplatT<T>& s, T px, T py) {
   SplatFalloffT<T> f;
   f.dx = s.mean[0] - px;
   f.dy = s.mean[1] - py;
-  const T power = T(-0.5) * (s.conic[0] * f.dx * f.dx + s.conic[2] * f.dy * f.dy) - s.conic[1] * f.dx * f.dy;
-  f.valid = !(power > T(0) || power < T(kPowerMin));
-  f.G = f.valid ? k_exp(power) : T(0);
+  const T power = splat_power(s, f.dx, f.dy);
+  f.valid = power_valid(power);
+  f.G = power_falloff(power);
   return f;
 }
 
 // alpha_i(u) = min(sigma_i G, alpha_max), or 0 when below kAlphaMin or the falloff is not valid.
 template <class T>
 RRG_HD inline T splat_alpha(const SplatT<T>& s, const SplatFalloffT<T>& f, T alpha_max) {
-  if (!f.valid) return T(0);
-  T alpha = s.opacity * f.G;
-  if (alpha > alpha_max) alpha = alpha_max;
-  return alpha < T(kAlphaMin) ? T(0) : alpha;
+  return f.valid ? falloff_alpha(s.opacity, f.G, alpha_max) : T(0);
 }
 
 template <class T>
@@ -104,24 +164,52 @@ struct BaseAccumT {
 // The depth cull. Where the raycast missed (D_t = 0) there is no surface to cull against.
 template <class T>
 RRG_HD inline bool base_visible(const SplatT<T>& s, T D_t, T eps) {
-  return !(D_t > T(0)) || s.depth < D_t + eps;
+  const T d = s.depth;
+  return !(D_t > T(0)) | (d < D_t + eps);
 }
 
-// Adds splat s with its (non-zero) alpha at a pixel.
+// Adds splat s with its (non-zero) alpha at a pixel, field by field (the CPU lane loop keeps each
+// field of a tile in its own array).
+template <class T>
+RRG_HD inline void base_add(T& C0, T& C1, T& C2, T& W_g, T& D_g, const SplatT<T>& s, T alpha) {
+  C0 += alpha * s.color[0];
+  C1 += alpha * s.color[1];
+  C2 += alpha * s.color[2];
+  W_g += alpha;
+  D_g += alpha * s.depth;
+}
+
 template <class T>
 RRG_HD inline void base_add(BaseAccumT<T>& acc, const SplatT<T>& s, T alpha) {
-  acc.C_g += alpha * Vec3<T>(s.color[0], s.color[1], s.color[2]);
-  acc.W_g += alpha;
-  acc.D_g += alpha * s.depth;
+  base_add(acc.C_g[0], acc.C_g[1], acc.C_g[2], acc.W_g, acc.D_g, s, alpha);
+}
+
+// Pass 2's falloff G of splat s at offset (dx, dy) from a pixel whose raycast depth is D_t: 0 where
+// it adds nothing (depth cull, outside its ellipse); its alpha is then falloff_alpha(opacity, G, 1)
+// where G != 0 (G > exp(kPowerMin) there), else 0.
+// (Both evaluate every term and then select, with no short-circuit and no memory read under a
+// condition: the form GCC turns into straight vector code in the CPU lane loop.)
+template <class T>
+RRG_HD inline T base_falloff_G(const SplatT<T>& s, T dx, T dy, T D_t, T eps) {
+  const T G = power_falloff(splat_power(s, dx, dy));
+  return base_visible(s, D_t, eps) ? G : T(0);
+}
+
+template <class T>
+RRG_HD inline T base_alpha(const SplatT<T>& s, T G) {
+  const T alpha = falloff_alpha(s.opacity, G, T(1));
+  return G != T(0) ? alpha : T(0);
 }
 
 // The falloff of splat s at pixel (px, py) where it adds to pass 2, and its alpha; alpha = 0 when
 // it adds nothing there (depth cull, outside its ellipse, alpha below kAlphaMin).
 template <class T>
 RRG_HD inline T base_falloff(const SplatT<T>& s, T px, T py, T D_t, T eps, SplatFalloffT<T>& f) {
-  if (!base_visible(s, D_t, eps)) return T(0);
-  f = splat_falloff(s, px, py);
-  return splat_alpha(s, f, T(1));
+  f.dx = s.mean[0] - px;
+  f.dy = s.mean[1] - py;
+  f.G = base_falloff_G(s, f.dx, f.dy, D_t, eps);
+  f.valid = f.G != T(0);
+  return base_alpha(s, f.G);
 }
 
 // Adds splat s at pixel (px, py); returns its alpha (0 when culled or negligible).

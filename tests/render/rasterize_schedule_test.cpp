@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <random>
 #include <stdexcept>
@@ -380,6 +381,49 @@ TEST(RasterizeSchedule, BackwardGradientsDoNotDependOnTheThreadCount) {
       EXPECT_TRUE(bitwise_equal(many.first, one.first)) << threads << " threads, run " << rep << " (pass 2)";
       EXPECT_TRUE(bitwise_equal(many.second, one.second)) << threads << " threads, run " << rep << " (pass 3)";
     }
+}
+
+}  // namespace
+}  // namespace rrg::kernel
+
+namespace rrg::kernel {
+namespace {
+
+// The CPU forward evaluates a splat on eight pixels of a row at once (rasterize_cpu.cpp); with
+// the same splats in the same order per pixel and no fused multiply-adds, its images are the
+// per-pixel loop's bit for bit.
+TEST(RasterizeSchedule, BasePassLanesGiveThePerPixelLoopsImagesBitForBit) {
+  Scene sc = make_scene(23, 300);
+  const size_t n = sc.C_t.size();
+  BaseOut tiled(n), pixel(n);
+  CpuRasterScratch scratch = poisoned_scratch(sc);
+  base_fwd_cpu(base_fwd_args(sc, tiled), scratch);
+  base_fwd(CpuBackend{}, base_fwd_args(sc, pixel));
+  EXPECT_EQ(std::memcmp(tiled.C_g.data(), pixel.C_g.data(), n * sizeof(Eigen::Vector3f)), 0);
+  EXPECT_EQ(std::memcmp(tiled.W_g.data(), pixel.W_g.data(), n * sizeof(float)), 0);
+  EXPECT_EQ(std::memcmp(tiled.D_g.data(), pixel.D_g.data(), n * sizeof(float)), 0);
+  EXPECT_EQ(std::memcmp(tiled.C_b.data(), pixel.C_b.data(), n * sizeof(Eigen::Vector3f)), 0);
+  EXPECT_EQ(std::memcmp(tiled.D_b.data(), pixel.D_b.data(), n * sizeof(float)), 0);
+}
+
+// falloff_exp (the falloff's e^x on the host, plain arithmetic so that it vectorises) against the
+// double exponential over the whole range the falloff uses, [kPowerMin, 0], and at its ends.
+TEST(RasterizeSchedule, FalloffExpIsWithinTwoUlpOfExp) {
+  float worst = 0.0f;
+  const int steps = 1 << 20;
+  for (int i = 0; i <= steps; ++i) {
+    const float x = kPowerMin * float(i) / float(steps);
+    const double ref = std::exp(double(x));
+    const float got = falloff_exp(x);
+    const double ulp = double(std::nextafter(float(ref), 2.0f) - float(ref));
+    worst = std::max(worst, float(std::abs(double(got) - ref) / ulp));
+  }
+  EXPECT_LE(worst, 2.0f);
+  EXPECT_EQ(falloff_exp(0.0f), 1.0f);
+  EXPECT_NEAR(falloff_exp(-1.0f), 0.36787944f, 1e-7f);
+  EXPECT_GT(falloff_exp(-87.0f), 0.0f);        // stays a normal float at the clamp
+  EXPECT_EQ(falloff_exp(-200.0f), falloff_exp(-87.0f));
+  std::printf("falloff_exp: worst error %.2f ulp over [kPowerMin, 0]\n", worst);
 }
 
 }  // namespace
