@@ -78,7 +78,7 @@ float ssim(const DeviceImage<Color>& x, const DeviceImage<Color>& y, DeviceImage
            Buffer<float>& scratch) {
   check_same(x, y, "ssim");
   if (v_x) check_same(x, *v_x, "ssim (gradient)");
-  const size_t need = size_t(x.width()) * size_t(x.height()) * 36;
+  const size_t need = size_t(x.width()) * size_t(x.height()) * kernel::kSsimScratch;
   if (scratch.size() < need || scratch.device() != x.device()) scratch = Buffer<float>(need, x.device());
   const auto win = make_window();
   float r = 0;

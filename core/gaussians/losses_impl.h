@@ -3,10 +3,15 @@
 // by losses_cpu.cpp (float and double) and losses_cuda.cu (float). Images are interleaved RGB
 // ([H, W, 3] scalars) or single-channel depth. Each function returns the loss value and, when v_x
 // is not empty, ADDS weight · ∂loss/∂x to v_x, so several terms share one upstream image.
+#include "core/common/parallel_for.h"
 #include "core/common/span.h"
 #include "core/gaussians/losses_device.h"
 
+#include <algorithm>
 #include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
 
 namespace rrg::kernel {
 
@@ -48,86 +53,98 @@ T depth_l1_loss(Backend be, Span<const T> d, Span<const T> d_gt, Span<T> v_d, T 
   return sc.sum / sc.count;
 }
 
-// s[ch][m] = Σ_k g(k) src[(q_k · 3 + ch) · M + m] over the SSIM window around pixel p along one axis
-// (q_k = p + k, or p + k · w when vertical), clipped at the image border (zero padding): one
-// separable pass over M stored moments per channel, taps in ascending k.
-template <int M, class T>
-RRG_HD inline void ssim_window_sum(const T* src, int64_t p, int w, int h, bool vertical, const SsimWindow<T>& win,
-                                   T (&s)[3][M]) {
+// One separable pass of the SSIM window over an array of C values per pixel ([H, W, C]): value e
+// of pixel p gets Σ_k g(k) src[(q_k · C) + e] with q_k = p + k (horizontal) or p + k · w (vertical),
+// over the taps whose pixel lies in the image (zero padding), in ascending k. This is the sum of one
+// element (CUDA: one thread each); the CPU runs the same sums tap by tap over whole rows
+// (ssim_pass_rows), which adds the same terms to each element in the same order.
+template <class T>
+RRG_HD inline T ssim_tap_sum(const T* src, int64_t i, int pos, int len, int64_t step, const SsimWindow<T>& win) {
   constexpr int R = kSsimRadius;
-  const int pos = vertical ? int(p / w) : int(p % w), len = vertical ? h : w;
   const int k0 = pos - R < 0 ? -pos : -R, k1 = pos + R >= len ? len - 1 - pos : R;
-  const int64_t step = vertical ? w : 1;
-  for (int ch = 0; ch < 3; ++ch)
-    for (int m = 0; m < M; ++m) s[ch][m] = T(0);
+  T s = T(0);
+  for (int k = k0; k <= k1; ++k) s += win.g[k + R] * src[i + k * step];
+  return s;
+}
+
+// Row y of a pass (C values per pixel) into out[0, w · C): for each tap k, the elements whose tap
+// pixel is inside form one contiguous run, so the inner loop is a plain vectorised axpy.
+template <class T>
+inline void ssim_pass_row(const T* src, T* out, int w, int h, int C, bool vertical, int y, const SsimWindow<T>& win) {
+  constexpr int R = kSsimRadius;
+  const int64_t row = int64_t(w) * C;
+  std::fill(out, out + row, T(0));
   for (int k = -R; k <= R; ++k) {
-    if (k < k0 || k > k1) continue;
-    const int64_t j = (p + k * step) * 3;
     const T g = win.g[k + R];
-    for (int ch = 0; ch < 3; ++ch)
-      for (int m = 0; m < M; ++m) s[ch][m] += g * src[(j + ch) * M + m];
+    if (vertical) {
+      if (y + k < 0 || y + k >= h) continue;
+      const T* s = src + int64_t(y + k) * row;
+      for (int64_t e = 0; e < row; ++e) out[e] += g * s[e];
+    } else {
+      const int x0 = k < 0 ? -k : 0, x1 = k > 0 ? w - k : w;
+      if (x0 >= x1) continue;
+      const T* s = src + int64_t(y) * row + int64_t(k) * C;
+      for (int64_t e = int64_t(x0) * C; e < int64_t(x1) * C; ++e) out[e] += g * s[e];
+    }
+  }
+}
+
+// The two passes of the window over C values per pixel: src -> mid (horizontal) -> out (vertical).
+template <class Backend, class T>
+void ssim_window(Backend be, int w, int h, int C, const T* src, T* mid, T* out, const SsimWindow<T>& win) {
+  const int64_t n = int64_t(w) * h;
+  if constexpr (std::is_same_v<Backend, CpuBackend>) {
+    parallel_for(be, h, [=](int64_t row) { ssim_pass_row(src, mid + row * w * C, w, h, C, false, int(row), win); });
+    parallel_for(be, h, [=](int64_t row) { ssim_pass_row(mid, out + row * w * C, w, h, C, true, int(row), win); });
+  } else {
+    parallel_for(be, n * C, [=] RRG_HD(int64_t i) { mid[i] = ssim_tap_sum(src, i, int((i / C) % w), w, int64_t(C), win); });
+    parallel_for(be, n * C, [=] RRG_HD(int64_t i) {
+      out[i] = ssim_tap_sum(mid, i, int((i / C) / w), h, int64_t(w) * C, win);
+    });
   }
 }
 
 // SSIM = mean over pixels and channels of the SSIM map (3DGS: 11×11 Gaussian window, σ = 1.5, zero
-// padding). Separable windowed sums; scratch holds 36 · W · H scalars. The gradient uses
+// padding). Separable windowed sums; scratch holds kSsimScratch · W · H scalars. The gradient uses
 // ∂SSIM_mean/∂x_q = 1/(3N) Σ_p g(p−q) [a(p) + 2 x_q b(p) + y_q c(p)]
 //                 = 1/(3N) [(g⋆a)(q) + 2 x_q (g⋆b)(q) + y_q (g⋆c)(q)]  (the window is symmetric).
+// Per pixel and channel the values are the moments x, y, x², y², xy (5), then a, b, c (3).
+inline constexpr int kSsimScratch = 15 + 15 + 15 + 9 + 9 + 9 + 3;
+
 template <class Backend, class T>
 T ssim(Backend be, int w, int h, Span<const T> x, Span<const T> y, Span<T> v_x, T weight,
        SsimWindow<T> win, Span<T> scratch) {
   const int64_t n = int64_t(w) * h;  // pixels
-  T* hm = scratch.data;              // [N, 3, 5] horizontal sums of x, y, x², y², xy
-  T* abc = hm + n * 15;              // [N, 3, 3] a, b, c
+  if (scratch.size < n * kSsimScratch)
+    throw std::invalid_argument("ssim: the scratch holds " + std::to_string(scratch.size) + " scalars, " +
+                                std::to_string(n * kSsimScratch) + " needed");
+  T* mom = scratch.data;             // [N, 3, 5] x, y, x², y², xy
+  T* hm = mom + n * 15;              // [N, 3, 5] their horizontal sums
+  T* vm = hm + n * 15;               // [N, 3, 5] then vertical: the windowed moments
+  T* abc = vm + n * 15;              // [N, 3, 3] a, b, c
   T* hs = abc + n * 9;               // [N, 3, 3] horizontal sums of a, b, c
-  T* smap = hs + n * 9;              // [N, 3] SSIM map
-  constexpr int R = kSsimRadius;
-  // One work item per pixel, its three channels together: the window's bounds and the index math
-  // are done once per pixel. Per channel the sums run over the taps in the same order as a loop per
-  // channel would, so the result does not depend on this grouping.
-  parallel_for(be, n, [=] RRG_HD(int64_t p) {
-    const int px = int(p % w), py = int(p / w);
-    const int k0 = px - R < 0 ? -px : -R, k1 = px + R >= w ? w - 1 - px : R;
-    T s[3][5] = {};
-    for (int k = -R; k <= R; ++k) {
-      if (k < k0 || k > k1) continue;
-      const int64_t j = (int64_t(py) * w + px + k) * 3;
-      const T g = win.g[k + R];
-      for (int ch = 0; ch < 3; ++ch) {
-        const T a = x[j + ch], b = y[j + ch];
-        s[ch][0] += g * a; s[ch][1] += g * b; s[ch][2] += g * a * a; s[ch][3] += g * b * b; s[ch][4] += g * a * b;
-      }
-    }
-    for (int ch = 0; ch < 3; ++ch)
-      for (int m = 0; m < 5; ++m) hm[(p * 3 + ch) * 5 + m] = s[ch][m];
+  T* vs = hs + n * 9;                // [N, 3, 3] then vertical
+  T* smap = vs + n * 9;              // [N, 3] SSIM map
+  parallel_for(be, n * 3, [=] RRG_HD(int64_t i) {
+    const T a = x[i], b = y[i];
+    T* m = mom + i * 5;
+    m[0] = a, m[1] = b, m[2] = a * a, m[3] = b * b, m[4] = a * b;
   });
-  parallel_for(be, n, [=] RRG_HD(int64_t p) {
-    T s[3][5];
-    ssim_window_sum<5>(hm, p, w, h, true, win, s);
-    for (int ch = 0; ch < 3; ++ch) {
-      const int64_t i = p * 3 + ch;
-      T a, b, c;
-      smap[i] = ssim_from_moments(s[ch][0], s[ch][1], s[ch][2], s[ch][3], s[ch][4], win.c1, win.c2, &a, &b, &c);
-      abc[i * 3 + 0] = a; abc[i * 3 + 1] = b; abc[i * 3 + 2] = c;
-    }
+  ssim_window(be, w, h, 15, mom, hm, vm, win);
+  parallel_for(be, n * 3, [=] RRG_HD(int64_t i) {
+    const T* s = vm + i * 5;
+    T a, b, c;
+    smap[i] = ssim_from_moments(s[0], s[1], s[2], s[3], s[4], win.c1, win.c2, &a, &b, &c);
+    abc[i * 3 + 0] = a, abc[i * 3 + 1] = b, abc[i * 3 + 2] = c;
   });
   const T total = parallel_reduce(
       be, n * 3, T(0), [=] RRG_HD(int64_t i) { return smap[i]; }, [] RRG_HD(T a, T b) { return a + b; });
   if (!v_x.empty()) {
-    parallel_for(be, n, [=] RRG_HD(int64_t p) {
-      T s[3][3];
-      ssim_window_sum<3>(abc, p, w, h, false, win, s);
-      for (int ch = 0; ch < 3; ++ch)
-        for (int m = 0; m < 3; ++m) hs[(p * 3 + ch) * 3 + m] = s[ch][m];
-    });
+    ssim_window(be, w, h, 9, abc, hs, vs, win);
     const T scale = weight / T(n * 3);
-    parallel_for(be, n, [=] RRG_HD(int64_t p) {
-      T s[3][3];
-      ssim_window_sum<3>(hs, p, w, h, true, win, s);
-      for (int ch = 0; ch < 3; ++ch) {
-        const int64_t i = p * 3 + ch;
-        v_x[i] += scale * (s[ch][0] + T(2) * x[i] * s[ch][1] + y[i] * s[ch][2]);
-      }
+    parallel_for(be, n * 3, [=] RRG_HD(int64_t i) {
+      const T* s = vs + i * 3;
+      v_x[i] += scale * (s[0] + T(2) * x[i] * s[1] + y[i] * s[2]);
     });
   }
   return total / T(n * 3);

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <functional>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 namespace rrg {
@@ -92,7 +93,7 @@ TEST(Losses, DepthL1IgnoresInvalidPixelsAndMatchesFiniteDifferences) {
 
 TEST(Losses, SsimKnownAnswersAndFiniteDifferences) {
   std::vector<double> x = random_image(W, H, 3, 5), y = random_image(W, H, 3, 6);
-  std::vector<double> scratch(size_t(W) * H * 36), g(x.size(), 0.0), none;
+  std::vector<double> scratch(size_t(W) * H * kernel::kSsimScratch), g(x.size(), 0.0), none;
   // SSIM(y, y) = 1 with a zero gradient (a maximum).
   std::vector<double> gy(x.size(), 0.0);
   EXPECT_NEAR(kernel::ssim_cpu<double>(W, H, cs(y), cs(y), ms(gy), 1.0, window_d(), ms(scratch)), 1.0, 1e-12);
@@ -103,6 +104,38 @@ TEST(Losses, SsimKnownAnswersAndFiniteDifferences) {
     return kernel::ssim_cpu<double>(W, H, cs(x), cs(y), ms(none), 1.0, window_d(), ms(scratch));
   }, 1e-6);
   EXPECT_LT(err, 1e-6);
+}
+
+// The CPU runs each pass of the SSIM window tap by tap over whole rows (ssim_pass_row, vectorised);
+// CUDA sums each element over its taps (ssim_tap_sum). Both add the same terms in the same order:
+// the same floats bit for bit, in both directions, borders (zero padding) included.
+TEST(Losses, SsimRowPassesEqualThePerElementTapSums) {
+  const int w = 37, h = 23, C = 15;  // fewer than 11 columns/rows from a border on both sides
+  std::vector<float> src(size_t(w) * h * C);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (float& v : src) v = u(rng);
+  kernel::SsimWindow<float> win{};
+  double total = 0;
+  for (int k = 0; k <= 2 * kernel::kSsimRadius; ++k) total += std::exp(-(k - 5) * (k - 5) / 4.5);
+  for (int k = 0; k <= 2 * kernel::kSsimRadius; ++k) win.g[k] = float(std::exp(-(k - 5) * (k - 5) / 4.5) / total);
+  for (const bool vertical : {false, true}) {
+    std::vector<float> rows(src.size());
+    for (int y = 0; y < h; ++y) kernel::ssim_pass_row(src.data(), rows.data() + size_t(y) * w * C, w, h, C, vertical, y, win);
+    int64_t differ = 0;
+    for (int64_t i = 0; i < int64_t(src.size()); ++i) {
+      const int pos = vertical ? int(i / C / w) : int(i / C % w);
+      const float e = kernel::ssim_tap_sum(src.data(), i, pos, vertical ? h : w, vertical ? int64_t(w) * C : int64_t(C), win);
+      differ += e == rows[size_t(i)] ? 0 : 1;
+    }
+    EXPECT_EQ(differ, 0) << (vertical ? "vertical" : "horizontal");
+  }
+}
+
+TEST(Losses, SsimRefusesAScratchTooSmall) {
+  std::vector<double> x = random_image(W, H, 3, 5), y = random_image(W, H, 3, 6), none;
+  std::vector<double> scratch(size_t(W) * H * kernel::kSsimScratch - 1);
+  EXPECT_THROW(kernel::ssim_cpu<double>(W, H, cs(x), cs(y), ms(none), 1.0, window_d(), ms(scratch)), std::invalid_argument);
 }
 
 TEST(Losses, SobelKnownAnswerAndFiniteDifferences) {
@@ -133,7 +166,7 @@ TEST(Losses, FloatApiMatchesDoubleAndDevicesAgree) {
   const std::vector<double> xd = random_image(W, H, 3, 8), yd = random_image(W, H, 3, 9), rd = random_image(W, H, 3, 10);
   const std::vector<double> dd = random_image(W, H, 1, 11, 1, 3), gtd = random_image(W, H, 1, 12, 1, 3);
   // double reference of the whole loss and its gradients
-  std::vector<double> scratch(size_t(W) * H * 36), vC(xd.size(), 0.0), vD(dd.size(), 0.0), vR(rd.size(), 0.0);
+  std::vector<double> scratch(size_t(W) * H * kernel::kSsimScratch), vC(xd.size(), 0.0), vD(dd.size(), 0.0), vR(rd.size(), 0.0);
   const double l1 = kernel::l1_loss_cpu<double>(cs(xd), cs(yd), ms(vC), 0.8);
   const double ss = kernel::ssim_cpu<double>(W, H, cs(xd), cs(yd), ms(vC), -0.2, window_d(), ms(scratch));
   const double dl = kernel::depth_l1_loss_cpu<double>(cs(dd), cs(gtd), ms(vD), 0.2);
