@@ -2,9 +2,8 @@
 // One splat at one pixel, for pass 2 (base, sort-free weighted sum with the depth cull) and pass 3
 // (reflection, front-to-back alpha compositing with the plane test): forward and backward, the only
 // copy of the math. Used by the CPU loop and by the CUDA kernels alike.
+#include "core/common/fast_math.h"
 #include "core/render/splat.h"
-
-#include <cstring>
 
 namespace rrg::kernel {
 
@@ -15,39 +14,9 @@ inline constexpr float kTransmittanceMin = 1e-4f;    // pass 3 stops before T dr
 // before the exp (an exact shortcut, not a new threshold).
 inline constexpr float kPowerMin = -5.5422645f;
 
-// e^x for the falloff, where x = power is in [kPowerMin, 0] (other x are clamped to [-87, 0], which
-// keeps the result a normal float). CUDA: expf. Host: range reduction x = n ln2 + r, |r| <= ln2 / 2
-// (n rounded to nearest by the 1.5 * 2^23 shift, ln2 split in two so that n ln2 is exact), the
-// degree-7 Taylor polynomial of e^r (truncation below r^8 / 8! e^r, about 1e-8 relative), and 2^n
-// set in the exponent bits. Plain arithmetic, so the compiler evaluates eight pixels at once in the
-// CPU rasteriser's lane loops (rasterize_cpu.cpp) with the same result as one at a time (no fused
-// multiply-adds: cmake/cpu_arch.cmake); within 2 ulp of e^x (RasterizeSchedule.FalloffExpIsWithinTwoUlpOfExp).
-RRG_HD RRG_INLINE float falloff_exp(float x) {
-#if defined(__CUDA_ARCH__)
-  return expf(x);
-#else
-  x = x < -87.0f ? -87.0f : (x > 0.0f ? 0.0f : x);
-  constexpr float kShift = 12582912.0f;  // 1.5 * 2^23
-  const float t = x * 1.44269504f + kShift;
-  const float n = t - kShift;  // round(x / ln2)
-  const float r = (x - n * 0.693359375f) + n * 2.12194440e-4f;  // ln2 = 0.693359375 - 2.12194440e-4
-  float p = 1.0f / 5040.0f;
-  p = p * r + 1.0f / 720.0f;
-  p = p * r + 1.0f / 120.0f;
-  p = p * r + 1.0f / 24.0f;
-  p = p * r + 1.0f / 6.0f;
-  p = p * r + 0.5f;
-  p = p * r + 1.0f;
-  p = p * r + 1.0f;
-  constexpr int32_t kShiftBits = 0x4B400000;  // the bits of kShift
-  int32_t ti;
-  std::memcpy(&ti, &t, sizeof ti);
-  const int32_t bits = (ti - kShiftBits + 127) * (int32_t(1) << 23);  // 2^n, n in [-126, 0]
-  float scale;
-  std::memcpy(&scale, &bits, sizeof scale);
-  return p * scale;
-#endif
-}
+// e^x for the falloff, x = power in [kPowerMin, 0]: exp_neg (core/common/fast_math.h), a polynomial
+// on the host that the CPU rasteriser's lane loop evaluates on eight pixels at once; expf on CUDA.
+RRG_HD RRG_INLINE float falloff_exp(float x) { return exp_neg(x); }
 RRG_HD RRG_INLINE double falloff_exp(double x) { return k_exp(x); }
 
 // The falloff of splat s at pixel (px, py): offset d = p_hat - u and G = exp(power), with

@@ -1,9 +1,11 @@
-// floor_to_int and min_f / max_f (core/common/fast_math.h) against the C library on the host.
+// floor_to_int, min_f / max_f and exp_neg (core/common/fast_math.h) against the C library on the host.
 #include "core/common/fast_math.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdint>
 #include <cstring>
 
@@ -52,6 +54,27 @@ TEST(FastMath, MinMaxOfNumbers) {
   // (voxel.h: encode_tsdf(NaN) = −1 as with fminf(fmaxf(NaN, −1), 1)).
   EXPECT_EQ(max_f(NAN, -1.0f), -1.0f);
   EXPECT_EQ(min_f(NAN, 1.0f), 1.0f);
+}
+
+// exp_neg against the double exponential over the range the Gaussian weights use: the splat
+// falloff's [kPowerMin, 0] = [-5.54, 0] densely, the bilateral filter's down to the clamp.
+TEST(FastMath, ExpNegIsWithinTwoUlpOfExp) {
+  float worst = 0.0f;
+  const auto check = [&](float x) {
+    const double ref = std::exp(double(x));
+    const double ulp = double(std::nextafter(float(ref), 2.0f) - float(ref));
+    worst = std::max(worst, float(std::abs(double(exp_neg(x)) - ref) / ulp));
+  };
+  const int steps = 1 << 20;
+  for (int i = 0; i <= steps; ++i) check(-5.5422645f * float(i) / float(steps));
+  for (int i = 0; i <= steps; ++i) check(-87.0f * float(i) / float(steps));
+  EXPECT_LE(worst, 2.0f);
+  EXPECT_EQ(exp_neg(0.0f), 1.0f);
+  EXPECT_NEAR(exp_neg(-1.0f), 0.36787944f, 1e-7f);
+  EXPECT_GT(exp_neg(-87.0f), 0.0f);  // a normal float at the clamp
+  EXPECT_EQ(exp_neg(-1000.0f), exp_neg(-87.0f));
+  EXPECT_EQ(exp_neg(3.0f), 1.0f);    // x > 0 is clamped to 0
+  std::printf("exp_neg: worst error %.2f ulp over [-87, 0]\n", worst);
 }
 
 }  // namespace

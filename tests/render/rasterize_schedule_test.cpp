@@ -406,25 +406,5 @@ TEST(RasterizeSchedule, BasePassLanesGiveThePerPixelLoopsImagesBitForBit) {
   EXPECT_EQ(std::memcmp(tiled.D_b.data(), pixel.D_b.data(), n * sizeof(float)), 0);
 }
 
-// falloff_exp (the falloff's e^x on the host, plain arithmetic so that it vectorises) against the
-// double exponential over the whole range the falloff uses, [kPowerMin, 0], and at its ends.
-TEST(RasterizeSchedule, FalloffExpIsWithinTwoUlpOfExp) {
-  float worst = 0.0f;
-  const int steps = 1 << 20;
-  for (int i = 0; i <= steps; ++i) {
-    const float x = kPowerMin * float(i) / float(steps);
-    const double ref = std::exp(double(x));
-    const float got = falloff_exp(x);
-    const double ulp = double(std::nextafter(float(ref), 2.0f) - float(ref));
-    worst = std::max(worst, float(std::abs(double(got) - ref) / ulp));
-  }
-  EXPECT_LE(worst, 2.0f);
-  EXPECT_EQ(falloff_exp(0.0f), 1.0f);
-  EXPECT_NEAR(falloff_exp(-1.0f), 0.36787944f, 1e-7f);
-  EXPECT_GT(falloff_exp(-87.0f), 0.0f);        // stays a normal float at the clamp
-  EXPECT_EQ(falloff_exp(-200.0f), falloff_exp(-87.0f));
-  std::printf("falloff_exp: worst error %.2f ulp over [kPowerMin, 0]\n", worst);
-}
-
 }  // namespace
 }  // namespace rrg::kernel
