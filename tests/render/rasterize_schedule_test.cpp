@@ -12,7 +12,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <random>
 #include <stdexcept>
@@ -253,6 +252,14 @@ TEST(RasterizeSchedule, BasePassMatchesThePerPixelLoop) {
     covered += pixel.W_g[i] > 0.0f ? 1 : 0;
   }
   EXPECT_GT(covered, int64_t(n) * 9 / 10);
+  // The CPU forward evaluates a splat on eight pixels of a row at once (rasterize_cpu.cpp); with
+  // the same splats in the same order per pixel and no fused multiply-adds, its images are the
+  // per-pixel loop's bit for bit.
+  EXPECT_EQ(std::memcmp(tiled.C_g.data(), pixel.C_g.data(), n * sizeof(Eigen::Vector3f)), 0);
+  EXPECT_EQ(std::memcmp(tiled.W_g.data(), pixel.W_g.data(), n * sizeof(float)), 0);
+  EXPECT_EQ(std::memcmp(tiled.D_g.data(), pixel.D_g.data(), n * sizeof(float)), 0);
+  EXPECT_EQ(std::memcmp(tiled.C_b.data(), pixel.C_b.data(), n * sizeof(Eigen::Vector3f)), 0);
+  EXPECT_EQ(std::memcmp(tiled.D_b.data(), pixel.D_b.data(), n * sizeof(float)), 0);
 
   // Backward from random upstream gradients (zero at some pixels).
   std::vector<SplatGrad> g_tiled(sc.splats.size(), SplatGrad{}), g_pixel(sc.splats.size(), SplatGrad{});
@@ -381,29 +388,6 @@ TEST(RasterizeSchedule, BackwardGradientsDoNotDependOnTheThreadCount) {
       EXPECT_TRUE(bitwise_equal(many.first, one.first)) << threads << " threads, run " << rep << " (pass 2)";
       EXPECT_TRUE(bitwise_equal(many.second, one.second)) << threads << " threads, run " << rep << " (pass 3)";
     }
-}
-
-}  // namespace
-}  // namespace rrg::kernel
-
-namespace rrg::kernel {
-namespace {
-
-// The CPU forward evaluates a splat on eight pixels of a row at once (rasterize_cpu.cpp); with
-// the same splats in the same order per pixel and no fused multiply-adds, its images are the
-// per-pixel loop's bit for bit.
-TEST(RasterizeSchedule, BasePassLanesGiveThePerPixelLoopsImagesBitForBit) {
-  Scene sc = make_scene(23, 300);
-  const size_t n = sc.C_t.size();
-  BaseOut tiled(n), pixel(n);
-  CpuRasterScratch scratch = poisoned_scratch(sc);
-  base_fwd_cpu(base_fwd_args(sc, tiled), scratch);
-  base_fwd(CpuBackend{}, base_fwd_args(sc, pixel));
-  EXPECT_EQ(std::memcmp(tiled.C_g.data(), pixel.C_g.data(), n * sizeof(Eigen::Vector3f)), 0);
-  EXPECT_EQ(std::memcmp(tiled.W_g.data(), pixel.W_g.data(), n * sizeof(float)), 0);
-  EXPECT_EQ(std::memcmp(tiled.D_g.data(), pixel.D_g.data(), n * sizeof(float)), 0);
-  EXPECT_EQ(std::memcmp(tiled.C_b.data(), pixel.C_b.data(), n * sizeof(Eigen::Vector3f)), 0);
-  EXPECT_EQ(std::memcmp(tiled.D_b.data(), pixel.D_b.data(), n * sizeof(float)), 0);
 }
 
 }  // namespace
