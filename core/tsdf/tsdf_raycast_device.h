@@ -138,13 +138,18 @@ RRG_TU_LOCAL RRG_HD inline bool march_step(const VolumeView& vol, MarchState& m,
   return false;
 }
 
+// A begun march run to its end: its hit.
+RRG_TU_LOCAL RRG_HD inline RayHit march_run(const VolumeView& vol, MarchState& m, BlockCache& cache) {
+  while (!march_step(vol, m, cache)) {
+  }
+  return m.hit;
+}
+
 RRG_TU_LOCAL RRG_HD inline RayHit march(const VolumeView& vol, const Eigen::Vector3f& o, const Eigen::Vector3f& d,
                            float truncation, float z_start, float z_end, BlockCache& cache) {
   MarchState m;
   march_begin(m, vol, o, d, truncation, z_start, z_end);
-  while (!march_step(vol, m, cache)) {
-  }
-  return m.hit;
+  return march_run(vol, m, cache);
 }
 
 struct SurfaceSample {

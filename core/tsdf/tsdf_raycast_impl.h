@@ -140,13 +140,7 @@ void raycast(Backend backend, const RaycastArgs& a) {
         MarchState m;
         const PixelRay ray = setup(item * run + r, i, m);
         if (ray == PixelRay::Outside) continue;
-        RayHit hit;
-        if (ray == PixelRay::March) {
-          while (!march_step(args.volume, m, cache)) {
-          }
-          hit = m.hit;
-        }
-        write(i, hit, cache);
+        write(i, ray == PixelRay::March ? march_run(args.volume, m, cache) : RayHit{}, cache);
       }
     });
   }
