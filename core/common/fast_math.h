@@ -29,19 +29,15 @@ RRG_HD inline int floor_to_int(float x) {
 RRG_HD inline float min_f(float a, float b) { return a < b ? a : b; }
 RRG_HD inline float max_f(float a, float b) { return a > b ? a : b; }
 
-// e^x for x <= 0 (Gaussian weights: the splat falloff, the bilateral filter); x is clamped to
-// [-87, 0], which keeps the result a normal float (e^-87 = 1.6e-38 stands for anything smaller).
-// CUDA: expf. Host: range reduction x = n ln2 + r, |r| <= ln2 / 2 (n rounded to nearest by the
-// 1.5 * 2^23 shift; ln2 split in two so that n ln2 is exact), the degree-7 Taylor polynomial of e^r
-// (truncation below r^8 / 8! e^r, about 1e-8 relative) and 2^n set in the exponent bits. Plain
-// arithmetic, inlined: the compiler evaluates eight of them at once in a vectorised loop with the
-// same result as one at a time (no fused multiply-adds: cmake/cpu_arch.cmake), where a call to
-// libm's expf keeps the loop scalar. Within 2 ulp of e^x (FastMath.ExpNegIsWithinTwoUlpOfExp).
-RRG_HD RRG_INLINE float exp_neg(float x) {
-#if defined(__CUDA_ARCH__)
-  return expf(x);
-#else
-  x = x < -87.0f ? -87.0f : (x > 0.0f ? 0.0f : x);
+// e^x on the host without libm, for per-element code that the compiler should vectorise: range
+// reduction x = n ln2 + r, |r| <= ln2 / 2 (n rounded to nearest by the 1.5 * 2^23 shift; ln2 split in
+// two so that n ln2 is exact), the degree-7 Taylor polynomial of e^r (truncation below r^8 / 8! e^r,
+// about 1e-8 relative) and 2^n set in the exponent bits. x must lie in [-87, 88] (2^n stays a
+// normal float). Plain arithmetic, inlined: the compiler evaluates eight of them at once in a
+// vectorised loop with the same result as one at a time (no fused multiply-adds:
+// cmake/cpu_arch.cmake), where a call to libm's expf keeps the loop scalar. Within 2 ulp of e^x
+// (FastMath.ExpNegIsWithinTwoUlpOfExp, FastMath.ExpClampedIsWithinTwoUlpOfExp).
+RRG_INLINE float exp_reduced_host(float x) {
   constexpr float kShift = 12582912.0f;      // 1.5 * 2^23
   constexpr int32_t kShiftBits = 0x4B400000;  // its bits
   const float t = x * 1.44269504f + kShift;
@@ -57,10 +53,31 @@ RRG_HD RRG_INLINE float exp_neg(float x) {
   p = p * r + 1.0f;
   int32_t ti;
   std::memcpy(&ti, &t, sizeof ti);
-  const int32_t bits = (ti - kShiftBits + 127) * (int32_t(1) << 23);  // 2^n, n in [-126, 0]
+  const int32_t bits = (ti - kShiftBits + 127) * (int32_t(1) << 23);  // 2^n, n in [-126, 127]
   float scale;
   std::memcpy(&scale, &bits, sizeof scale);
   return p * scale;
+}
+
+// e^x for x <= 0 (Gaussian weights: the splat falloff, the bilateral filter); x is clamped to
+// [-87, 0], which keeps the result a normal float (e^-87 = 1.6e-38 stands for anything smaller).
+// CUDA: expf; host: exp_reduced_host.
+RRG_HD RRG_INLINE float exp_neg(float x) {
+#if defined(__CUDA_ARCH__)
+  return expf(x);
+#else
+  return exp_reduced_host(x < -87.0f ? -87.0f : (x > 0.0f ? 0.0f : x));
+#endif
+}
+
+// e^x with x clamped to [-87, 88] (e^88 = 1.7e38 stands for anything larger): the projection's
+// scales exp(log s) and opacities sigmoid(l). CUDA: expf (inf above 88.7, a denormal or 0 below
+// -87); host: exp_reduced_host.
+RRG_HD RRG_INLINE float exp_clamped(float x) {
+#if defined(__CUDA_ARCH__)
+  return expf(x);
+#else
+  return exp_reduced_host(x < -87.0f ? -87.0f : (x > 88.0f ? 88.0f : x));
 #endif
 }
 

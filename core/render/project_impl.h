@@ -15,14 +15,17 @@ RRG_HD inline GaussianInT<float, S> gaussian_at(const GaussianViews& g, int64_t 
   return {g.means[i], g.log_scales[i], g.quats[i], g.logit_opacities[i], &g.sh[i * stride]};
 }
 
-// splats[i], rects[i] for every Gaussian; culled ones get an empty rect.
+// splats[i], rects[i] for every Gaussian, one per work item; culled ones get a zero splat and an
+// empty rect. The CPU back end runs project_lanes (project_cpu.cpp) instead: the same
+// project_gaussian on eight Gaussians at once, bit for bit these results
+// (Projection.LanesMatchThePerGaussianLoop).
 template <class Backend>
 void project_splats(Backend b, View view, GaussianViews g, Span<Splat> splats, Span<TileRect> rects) {
   parallel_for(b, g.means.size, [=] RRG_HD(int64_t i) {
-    const auto gi = gaussian_at<Eigen::Vector3f>(g, i, view.sh_stride);
     Splat s{};
     float radius = 0;
-    if (!project_gaussian<float, Eigen::Vector3f>(view, gi, s, radius)) {
+    if (!centre_in_reach(view, g.means[i]) ||
+        !project_gaussian(view, gaussian_at<Eigen::Vector3f>(g, i, view.sh_stride), s, radius)) {
       splats[i] = Splat{};
       rects[i] = TileRect{};
       return;
@@ -77,6 +80,25 @@ void tile_ranges(Backend b, Span<const uint64_t> keys, bool with_depth, Span<Til
   });
 }
 
+// Writes Gaussian i's parameter gradients (SH rows up to the stride) and touched = whether any is
+// non-zero.
+RRG_HD inline void store_gaussian_grad(const GaussianGradViews& v, int64_t i, int sh_stride, const Vec3<float>& v_mean,
+                                       const Vec3<float>& v_log_scale, const Vec4<float>& v_quat, float v_logit,
+                                       const Vec3<float>* v_sh) {
+  v.v_means[i] = v_mean;
+  v.v_log_scales[i] = v_log_scale;
+  v.v_quats[i] = v_quat;
+  v.v_logit_opacities[i] = v_logit;
+  bool nonzero = v_logit != 0.0f;
+  for (int c = 0; c < 3; ++c) nonzero = nonzero || v_mean[c] != 0.0f || v_log_scale[c] != 0.0f;
+  for (int c = 0; c < 4; ++c) nonzero = nonzero || v_quat[c] != 0.0f;
+  for (int k = 0; k < sh_stride; ++k) {
+    v.v_sh[i * sh_stride + k] = v_sh[k];
+    for (int c = 0; c < 3; ++c) nonzero = nonzero || v_sh[k][c] != 0.0f;
+  }
+  v.touched[i] = nonzero ? 1 : 0;
+}
+
 // Gradients of the Gaussian parameters from the splat gradients, and `touched`. A splat no pixel
 // sent gradient to (the part of the map outside the view) has zero parameter gradients: it is marked
 // 0 and its v_* entries are not written (GaussianGrads), so an iteration costs nothing per
@@ -94,27 +116,22 @@ void project_bwd(Backend b, View view, GaussianViews g, Span<const SplatGrad> v_
     Vec3<float> v_mean = Vec3<float>::Zero(), v_log_scale = Vec3<float>::Zero();
     Vec4<float> v_quat = Vec4<float>::Zero();
     float v_logit = 0;
-    {
-      const auto gi = gaussian_at<Eigen::Vector3f>(g, i, view.sh_stride);
-      project_gaussian_bwd<float, Eigen::Vector3f>(view, gi, v_splats[i], v_mean, v_log_scale, v_quat, v_logit,
-                                                   v_sh_local);
+    if (!project_gaussian_bwd(view, gaussian_at<Eigen::Vector3f>(g, i, view.sh_stride), view.sh_degree, v_splats[i],
+                              v_mean, v_log_scale, v_quat, v_logit, v_sh_local)) {
+      // culled (never the case for a splat that drew a pixel): no gradient
+      v_mean.setZero();
+      v_log_scale.setZero();
+      v_quat.setZero();
+      v_logit = 0;
+      for (int k = 0; k < kMaxShCoeffs; ++k) v_sh_local[k].setZero();
     }
-    v.v_means[i] = v_mean;
-    v.v_log_scales[i] = v_log_scale;
-    v.v_quats[i] = v_quat;
-    v.v_logit_opacities[i] = v_logit;
-    bool nonzero = v_logit != 0.0f;
-    for (int c = 0; c < 3; ++c) nonzero = nonzero || v_mean[c] != 0.0f || v_log_scale[c] != 0.0f;
-    for (int c = 0; c < 4; ++c) nonzero = nonzero || v_quat[c] != 0.0f;
-    for (int k = 0; k < view.sh_stride; ++k) {
-      v.v_sh[i * view.sh_stride + k] = v_sh_local[k];
-      for (int c = 0; c < 3; ++c) nonzero = nonzero || v_sh_local[k][c] != 0.0f;
-    }
-    v.touched[i] = nonzero ? 1 : 0;
+    store_gaussian_grad(v, i, view.sh_stride, v_mean, v_log_scale, v_quat, v_logit, v_sh_local);
   });
 }
 
 void project_splats_cpu(View view, GaussianViews g, Span<Splat> splats, Span<TileRect> rects);
+// The per-Gaussian loop above on the CPU (what CUDA runs): the reference of the lanes' test.
+void project_splats_per_gaussian_cpu(View view, GaussianViews g, Span<Splat> splats, Span<TileRect> rects);
 void project_splats_cuda(View view, GaussianViews g, Span<Splat> splats, Span<TileRect> rects);
 void count_tiles_cpu(Span<const TileRect> rects, Span<const int32_t> plane_ids, int32_t plane, Span<int32_t> counts);
 void count_tiles_cuda(Span<const TileRect> rects, Span<const int32_t> plane_ids, int32_t plane, Span<int32_t> counts);
@@ -125,6 +142,8 @@ void write_keys_cuda(int tiles_x, Span<const TileRect> rects, Span<const Splat> 
 void tile_ranges_cpu(Span<const uint64_t> keys, bool with_depth, Span<TileRange> ranges);
 void tile_ranges_cuda(Span<const uint64_t> keys, bool with_depth, Span<TileRange> ranges);
 void project_bwd_cpu(View view, GaussianViews g, Span<const SplatGrad> v_splats, GaussianGradViews v);
+// The per-Gaussian loop above on the CPU (what CUDA runs): the reference of the lanes' test.
+void project_bwd_per_gaussian_cpu(View view, GaussianViews g, Span<const SplatGrad> v_splats, GaussianGradViews v);
 void project_bwd_cuda(View view, GaussianViews g, Span<const SplatGrad> v_splats, GaussianGradViews v);
 
 }  // namespace rrg::kernel

@@ -2,6 +2,7 @@
 // View-dependent colour from spherical harmonics, 3DGS basis and constants, degrees 0-3:
 // c = max(sum_k b_k(d) SH_k + 0.5, 0), d the unit direction from the camera centre to the mean.
 // Forward and backward, the only copy.
+#include "core/common/hd.h"
 #include "core/render/splat.h"
 
 namespace rrg::kernel {
@@ -10,7 +11,7 @@ inline constexpr int kMaxShCoeffs = 16;
 
 // b[k] for k < (degree+1)^2 at the unit direction d; db[k] = grad_d b_k when db is not null.
 template <class T>
-RRG_HD inline void sh_basis(int degree, const Vec3<T>& d, T* b, Vec3<T>* db) {
+RRG_HD RRG_INLINE void sh_basis(int degree, const Vec3<T>& d, T* b, Vec3<T>* db) {
   constexpr double C0 = 0.28209479177387814, C1 = 0.4886025119029199;
   constexpr double C2[5] = {1.0925484305920792, -1.0925484305920792, 0.31539156525252005,
                             -1.0925484305920792, 0.5462742152960396};
@@ -62,38 +63,81 @@ RRG_HD inline void sh_basis(int degree, const Vec3<T>& d, T* b, Vec3<T>* db) {
   }
 }
 
-// c = max(sum_k b_k(dir(p)) SH_k + 0.5, 0), dir(p) = (p - o) / |p - o|, o the camera centre.
-template <class T, class S>
-RRG_HD inline Vec3<T> sh_color(int degree, const S* sh, const Vec3<T>& mean, const Vec3<T>& center) {
-  const Vec3<T> d = (mean - center).normalized();
+// The coefficients of one Gaussian: sh[k] of the storage's [K, 3] rows (a pointer), or one lane of a
+// block of L Gaussians copied lane-major (LaneSh: channel c of coefficient k at p[(3 k + c) L], p at
+// the lane's first element), which the CPU projection reads in its vector loop (project_cpu.cpp).
+template <int L>
+struct LaneSh {
+  const float* p;
+};
+
+template <class T, class V>
+RRG_HD RRG_INLINE Vec3<T> sh_coeff(const V* sh, int k) {
+  return sh[k].template cast<T>();
+}
+
+template <class T, int L>
+RRG_HD RRG_INLINE Vec3<T> sh_coeff(LaneSh<L> sh, int k) {
+  return {T(sh.p[(3 * k) * L]), T(sh.p[(3 * k + 1) * L]), T(sh.p[(3 * k + 2) * L])};
+}
+
+// raw = sum_k b_k SH_k + 0.5 (unrolled: with a constant degree the CPU vector loop needs no inner loop).
+template <class T, class Sh>
+RRG_HD RRG_INLINE Vec3<T> sh_raw(int degree, Sh sh, const T* b) {
+  Vec3<T> raw(T(0.5), T(0.5), T(0.5));
+  RRG_UNROLL
+  for (int k = 0; k < (degree + 1) * (degree + 1); ++k) raw += b[k] * sh_coeff<T>(sh, k);
+  return raw;
+}
+
+// c = max(sum_k b_k(dir(p)) SH_k + 0.5, 0), dir(p) = (p - o) / |p - o|, o the camera centre (p = o
+// gives NaN: such a mean is behind the near plane and culled).
+template <class T, class Sh>
+RRG_HD RRG_INLINE Vec3<T> sh_color(int degree, Sh sh, const Vec3<T>& mean, const Vec3<T>& center) {
+  const Vec3<T> v = mean - center;
+  const Vec3<T> d = v / k_sqrt(v.squaredNorm());
   T b[kMaxShCoeffs];
   sh_basis<T>(degree, d, b, nullptr);
-  Vec3<T> c(T(0.5), T(0.5), T(0.5));
-  for (int k = 0; k < (degree + 1) * (degree + 1); ++k) c += b[k] * sh[k].template cast<T>();
-  return c.cwiseMax(T(0));
+  return sh_raw<T>(degree, sh, b).cwiseMax(T(0));
+}
+
+// Where the backward adds the coefficients' gradients: rows of [K, 3] (a pointer), or one lane of
+// a lane-major block (LaneShGrad, the layout of LaneSh).
+template <int L>
+struct LaneShGrad {
+  float* p;
+};
+
+template <class T, class V>
+RRG_HD RRG_INLINE void sh_grad_add(V* v_sh, int k, const Vec3<T>& g) {
+  v_sh[k] += g;
+}
+
+template <class T, int L>
+RRG_HD RRG_INLINE void sh_grad_add(LaneShGrad<L> v_sh, int k, const Vec3<T>& g) {
+  for (int c = 0; c < 3; ++c) v_sh.p[(3 * k + c) * L] += g[c];
 }
 
 // Backward of sh_color: v_sh[k] += b_k * v_raw (channels clamped at 0 pass no gradient); returns
 // the gradient w.r.t. the mean through the view direction.
-template <class T, class S>
-RRG_TU_LOCAL RRG_HD inline Vec3<T> sh_color_bwd(int degree, const S* sh, const Vec3<T>& mean, const Vec3<T>& center,
-                                   const Vec3<T>& v_color, Vec3<T>* v_sh) {
+template <class T, class Sh, class VSh>
+RRG_TU_LOCAL RRG_HD RRG_INLINE Vec3<T> sh_color_bwd(int degree, Sh sh, const Vec3<T>& mean, const Vec3<T>& center,
+                                                    const Vec3<T>& v_color, VSh v_sh) {
   const Vec3<T> v = mean - center;
-  const T len = v.norm();
+  const T len = k_sqrt(v.squaredNorm());
   const Vec3<T> d = v / len;
   T b[kMaxShCoeffs];
   Vec3<T> db[kMaxShCoeffs];
+  for (int k = 0; k < kMaxShCoeffs; ++k) db[k].setZero();  // (only the first K are read; GCC cannot tell)
   sh_basis<T>(degree, d, b, db);
-  const int K = (degree + 1) * (degree + 1);
-  Vec3<T> raw(T(0.5), T(0.5), T(0.5));
-  for (int k = 0; k < K; ++k) raw += b[k] * sh[k].template cast<T>();
-  Vec3<T> v_raw = v_color;
-  for (int ch = 0; ch < 3; ++ch)
-    if (raw[ch] < T(0)) v_raw[ch] = T(0);
+  const Vec3<T> raw = sh_raw<T>(degree, sh, b);
+  Vec3<T> v_raw;
+  for (int ch = 0; ch < 3; ++ch) v_raw[ch] = raw[ch] < T(0) ? T(0) : v_color[ch];
   Vec3<T> v_d = Vec3<T>::Zero();
-  for (int k = 0; k < K; ++k) {
-    v_sh[k] += b[k] * v_raw;
-    v_d += sh[k].template cast<T>().dot(v_raw) * db[k];
+  RRG_UNROLL
+  for (int k = 0; k < (degree + 1) * (degree + 1); ++k) {
+    sh_grad_add<T>(v_sh, k, Vec3<T>(b[k] * v_raw));
+    v_d += sh_coeff<T>(sh, k).dot(v_raw) * db[k];
   }
   // d = v / |v|: v_v = (v_d - d (d . v_d)) / |v|
   return (v_d - d * d.dot(v_d)) / len;

@@ -69,13 +69,13 @@ struct ViewT {
   int32_t sh_degree;  // degree evaluated (<= the set's)
   int32_t sh_stride;  // coefficients stored per Gaussian
 
-  RRG_HD Mat3<T> R() const {
+  RRG_HD RRG_INLINE Mat3<T> R() const {
     Mat3<T> m;
     m << R_cw[0], R_cw[1], R_cw[2], R_cw[3], R_cw[4], R_cw[5], R_cw[6], R_cw[7], R_cw[8];
     return m;
   }
-  RRG_HD Vec3<T> t() const { return {t_cw[0], t_cw[1], t_cw[2]}; }
-  RRG_HD Vec3<T> center() const { return {center_w[0], center_w[1], center_w[2]}; }
+  RRG_HD RRG_INLINE Vec3<T> t() const { return {t_cw[0], t_cw[1], t_cw[2]}; }
+  RRG_HD RRG_INLINE Vec3<T> center() const { return {center_w[0], center_w[1], center_w[2]}; }
   RRG_HD int tiles_x() const { return (width + kTileSize - 1) / kTileSize; }
   RRG_HD int tiles_y() const { return (height + kTileSize - 1) / kTileSize; }
 };

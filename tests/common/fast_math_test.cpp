@@ -77,5 +77,28 @@ TEST(FastMath, ExpNegIsWithinTwoUlpOfExp) {
   std::printf("exp_neg: worst error %.2f ulp over [-87, 0]\n", worst);
 }
 
+// exp_clamped (the projection's exp(log s) and sigmoid) over its whole range [-87, 88], and the
+// clamps at either end.
+TEST(FastMath, ExpClampedIsWithinTwoUlpOfExp) {
+  float worst = 0.0f;
+  const int steps = 1 << 21;
+  for (int i = 0; i <= steps; ++i) {
+    const float x = -87.0f + 175.0f * float(i) / float(steps);
+    const double ref = std::exp(double(x));
+    const double ulp = double(std::nextafter(float(ref), INFINITY) - float(ref));
+    worst = std::max(worst, float(std::abs(double(exp_clamped(x)) - ref) / ulp));
+  }
+  EXPECT_LE(worst, 2.0f);
+  EXPECT_EQ(exp_clamped(0.0f), 1.0f);
+  EXPECT_NEAR(exp_clamped(1.0f), 2.7182818f, 3e-7f);
+  EXPECT_EQ(exp_clamped(-1000.0f), exp_clamped(-87.0f));
+  EXPECT_EQ(exp_clamped(1000.0f), exp_clamped(88.0f));
+  EXPECT_TRUE(std::isfinite(exp_clamped(88.0f)));
+  EXPECT_GT(exp_clamped(88.0f), 1e38f);
+  // the same polynomial as exp_neg where both apply
+  for (const float x : {-80.0f, -5.0f, -0.3f, 0.0f}) EXPECT_EQ(exp_clamped(x), exp_neg(x));
+  std::printf("exp_clamped: worst error %.2f ulp over [-87, 88]\n", worst);
+}
+
 }  // namespace
 }  // namespace rrg
