@@ -1,7 +1,10 @@
 #pragma once
 // Per-voxel fusion math (paper §4.1.4 and the supplement "TSDF Color Variance Update"): the only
 // copy, used by the fusion kernel on both back ends.
+#include "core/common/camera.h"
+#include "core/common/hd.h"
 #include "core/common/span.h"
+#include "core/tsdf/fusion_pixel.h"
 #include "core/tsdf/voxel.h"
 
 #include <Eigen/Core>
@@ -19,6 +22,58 @@ RRG_HD inline int32_t canonical_plane(Span<const int32_t> remap, int32_t id) {
   if (id <= 0) return 0;
   if (id < remap.size && remap[id] >= 0) return remap[id];
   return id;
+}
+
+// What the per-voxel tests need of the frame's camera, computed once per frame.
+struct VoxelProjection {
+  float fx, fy, cx, cy;
+  float inv_fx, inv_fy;
+  float width, height;  // of the fusion-pixel image
+  float truncation, inv_truncation;
+};
+
+inline VoxelProjection voxel_projection(const Intrinsics& K, int width, int height, float truncation) {
+  return {K.fx, K.fy, K.cx, K.cy, 1.0f / K.fx, 1.0f / K.fy, float(width), float(height), truncation, 1.0f / truncation};
+}
+
+// The nearest pixel (u, v) of a voxel at camera-frame position p_c; false when it is behind the
+// camera or outside the image. Nearest pixel: floor(x + 0.5). The range test runs on the floats (it
+// also rejects NaN and coordinates too large for an int); on [0, size) the truncating conversion is
+// the floor. Straight-line (u, v are set either way) so that the CPU evaluates a row of voxels at
+// once (tsdf_integrate_cpu.cpp).
+RRG_HD RRG_INLINE bool voxel_pixel(const VoxelProjection& vp, const Eigen::Vector3f& p_c, int& u, int& v) {
+  const float inv_z = 1.0f / p_c.z();  // K.project with one division
+  const float uf = vp.fx * p_c.x() * inv_z + vp.cx + 0.5f;
+  const float vf = vp.fy * p_c.y() * inv_z + vp.cy + 0.5f;
+  const bool ok = (p_c.z() > 0.0f) & (uf >= 0.0f) & (vf >= 0.0f) & (uf < vp.width) & (vf < vp.height);
+  u = ok ? int(uf) : 0;
+  v = ok ? int(vf) : 0;
+  return ok;
+}
+
+// How a voxel at p_c is fused from its pixel (u, v) with fusion data px (tsdf_integrate_impl.h's
+// integrate() explains the tests): not at all, as free space beyond the band (t = 1), or inside
+// the band, where identification frames also update the reflection attributes. Straight-line.
+struct VoxelFusion {
+  enum Kind : int32_t { kNone = 0, kFreeSpace = 1, kBand = 2 };
+  float t;      // min(1, sdf / ε), the observation fused
+  int32_t kind;
+};
+
+RRG_HD RRG_INLINE VoxelFusion voxel_fusion(const VoxelProjection& vp, const FusionPixel& px, int u, int v,
+                                           const Eigen::Vector3f& p_c) {
+  const Eigen::Vector3f P((float(u) - vp.cx) * vp.inv_fx * px.d, (float(v) - vp.cy) * vp.inv_fy * px.d, px.d);
+  const Eigen::Vector3f dp = p_c - P;
+  const float sdf = px.nx * dp.x() + px.ny * dp.y() + px.nz * dp.z();
+  const bool skipped = !(px.d > 0.0f) | (sdf < -vp.truncation);  // no pixel data; behind the band
+  const bool in_band = sdf < vp.truncation;
+  const bool near_point = !(dp.squaredNorm() > vp.truncation * vp.truncation);
+  const float ratio = sdf * vp.inv_truncation;  // (read unconditionally: a read under the select keeps the loop scalar)
+  VoxelFusion f;
+  f.t = sdf >= vp.truncation ? 1.0f : ratio;
+  f.kind = skipped ? VoxelFusion::kNone
+                   : (!in_band ? VoxelFusion::kFreeSpace : (near_point ? VoxelFusion::kBand : VoxelFusion::kNone));
+  return f;
 }
 
 // Standard fusion with one observation of normalised distance t_obs = min(1, sdf / ε):

@@ -57,6 +57,26 @@ struct IntegrateArgs {
   Span<const int32_t> remap;               // plane id -> canonical id
 };
 
+// The camera-frame position of the first voxel of row `row` (y + 8 z) of block `block`.
+template <class ColorT>
+RRG_HD RRG_INLINE Eigen::Vector3f row_start(const IntegrateArgs<ColorT>& args, int32_t block, int row) {
+  const Eigen::Vector3i g0 = block_coord(args.block_keys[block]) * int(kBlockSide) + Eigen::Vector3i(0, row & 7, row >> 3);
+  return args.R_cw * (g0.cast<float>() * args.voxel_size) + args.t_cw;
+}
+
+// Voxel k observed at pixel (u, v) as f says: the running averages, and on identification frames
+// inside the band the reflection attributes.
+template <class ColorT>
+RRG_HD RRG_INLINE void fuse_voxel(const IntegrateArgs<ColorT>& args, int64_t k, int u, int v, const VoxelFusion& f) {
+  AttrVoxel& attr = args.attributes[k];
+  const Eigen::Vector3f c = to_color(args.color(u, v));
+  fuse_sdf_color(args.geometry[k], attr, f.t, c, args.max_weight);
+  if (args.reflection && f.kind == VoxelFusion::kBand) {
+    const float m = args.mask(u, v) ? 1.0f : 0.0f;
+    fuse_reflection(attr, c, m, canonical_plane(args.remap, args.plane_ids(u, v)), args.window);
+  }
+}
+
 // Every voxel of every active block. The voxel p projects to pixel u with depth D(u),
 // surface point P = D(u) K^-1 [u, 1] and normal n (N_k^l); its signed distance is the
 // point-to-plane sdf = n · (p − P), which stays a metric distance on oblique surfaces where the
@@ -64,47 +84,27 @@ struct IntegrateArgs {
 // a hole) or seen at grazing angles (cos θ < kMinCos) are not fused (FusionPixel). Inside the band
 // the plane is trusted only within ε of P (|p − P| <= ε: its error is then at most ε² / 2ρ for a
 // surface of curvature radius ρ); farther voxels that are not free space (sdf < ε) are left alone.
-// Voxels with sdf < −ε are skipped; the others fuse min(1, sdf / ε).
+// Voxels with sdf < −ε are skipped; the others fuse min(1, sdf / ε) (voxel_pixel, voxel_fusion and
+// fuse_voxel in tsdf_integrate_device.h). One work item per row of 8 voxels along x (a block has
+// 64): the block's data is decoded once and the camera-frame position advances by one vector add
+// per voxel. The CPU back end runs integrate_rows_cpu (tsdf_integrate_cpu.cpp) instead: the same
+// pieces on the row's 8 voxels at once, with the same result (TsdfIntegrate.RowLanesMatchThePerVoxelLoop).
 template <class Backend, class ColorT>
 void integrate(Backend backend, const IntegrateArgs<ColorT>& a) {
   const IntegrateArgs<ColorT> args = a;
-  const float inv_fx = 1.0f / a.K.fx, inv_fy = 1.0f / a.K.fy, inv_trunc = 1.0f / a.truncation;
+  const VoxelProjection vp = voxel_projection(a.K, a.pixels.width, a.pixels.height, a.truncation);
   const Eigen::Vector3f step_x = a.R_cw.col(0) * a.voxel_size;  // camera-frame step of one voxel in x
-  const float width = float(a.pixels.width), height = float(a.pixels.height);
-  // One work item per row of 8 voxels along x (a block has 64): the block's data is decoded once
-  // and the camera-frame position advances by one vector add per voxel.
   parallel_for(backend, a.active.size * (kBlockVoxels / kBlockSide), [=] RRG_HD(int64_t item) {
     const int32_t block = args.active[item / (kBlockVoxels / kBlockSide)];
     const int row = int(item % (kBlockVoxels / kBlockSide));  // y + 8 z
     if (row == 0) args.versions[block] = args.version;
-    const Eigen::Vector3i g0 = block_coord(args.block_keys[block]) * int(kBlockSide) + Eigen::Vector3i(0, row & 7, row >> 3);
-    Eigen::Vector3f p_c = args.R_cw * (g0.cast<float>() * args.voxel_size) + args.t_cw;
+    Eigen::Vector3f p_c = row_start(args, block, row);
     const int64_t k0 = int64_t(block) * kBlockVoxels + int64_t(row) * kBlockSide;
     for (int x = 0; x < kBlockSide; ++x, p_c += step_x) {
-      if (!(p_c.z() > 0.0f)) continue;
-      const float inv_z = 1.0f / p_c.z();  // K.project with one division
-      // Nearest pixel: floor(x + 0.5). The range test runs on the floats (it also rejects NaN and
-      // coordinates too large for an int); on [0, size) the truncating conversion is the floor.
-      const float uf = args.K.fx * p_c.x() * inv_z + args.K.cx + 0.5f;
-      const float vf = args.K.fy * p_c.y() * inv_z + args.K.cy + 0.5f;
-      if (!(uf >= 0.0f && vf >= 0.0f && uf < width && vf < height)) continue;
-      const int u = int(uf), v = int(vf);
-      const FusionPixel px = args.pixels(u, v);
-      if (!(px.d > 0.0f)) continue;
-      const Eigen::Vector3f P((float(u) - args.K.cx) * inv_fx * px.d, (float(v) - args.K.cy) * inv_fy * px.d, px.d);
-      const Eigen::Vector3f dp = p_c - P;
-      const float sdf = px.nx * dp.x() + px.ny * dp.y() + px.nz * dp.z();
-      if (sdf < -args.truncation) continue;
-      if (sdf < args.truncation && dp.squaredNorm() > args.truncation * args.truncation) continue;
-      const float t = sdf >= args.truncation ? 1.0f : sdf * inv_trunc;
-      const int64_t k = k0 + x;
-      AttrVoxel& attr = args.attributes[k];
-      const Eigen::Vector3f c = to_color(args.color(u, v));
-      fuse_sdf_color(args.geometry[k], attr, t, c, args.max_weight);
-      if (args.reflection && sdf < args.truncation) {
-        const float m = args.mask(u, v) ? 1.0f : 0.0f;
-        fuse_reflection(attr, c, m, canonical_plane(args.remap, args.plane_ids(u, v)), args.window);
-      }
+      int u, v;
+      if (!voxel_pixel(vp, p_c, u, v)) continue;
+      const VoxelFusion f = voxel_fusion(vp, args.pixels(u, v), u, v, p_c);
+      if (f.kind != VoxelFusion::kNone) fuse_voxel(args, k0 + x, u, v, f);
     }
   });
 }
@@ -113,6 +113,9 @@ void fusion_pixels_cpu(const FusionPixelArgs& a);
 void fusion_pixels_cuda(const FusionPixelArgs& a);
 void integrate_cpu(const IntegrateArgs<Eigen::Vector3f>& a);
 void integrate_cpu(const IntegrateArgs<Rgb8>& a);
+// The per-voxel loop above on the CPU (what CUDA runs): the reference of the row lanes' test.
+void integrate_per_voxel_cpu(const IntegrateArgs<Eigen::Vector3f>& a);
+void integrate_per_voxel_cpu(const IntegrateArgs<Rgb8>& a);
 void integrate_cuda(const IntegrateArgs<Eigen::Vector3f>& a);
 void integrate_cuda(const IntegrateArgs<Rgb8>& a);
 
