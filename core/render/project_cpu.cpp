@@ -25,11 +25,11 @@ struct LaneInputs {
 // Gaussian i in lane l of a vector loop: written out in the loop body, in one go, the quaternion
 // component by component (a helper returning the record, members assigned afterwards, or a
 // Vector4f copy, 4-float packet code, each keep the loop scalar).
-#define RRG_LANE_GAUSSIAN(in, i, l)                                                                     \
-  GaussianInT<float, Eigen::Vector3f, LaneSh<kLanes>> {                                                  \
-    (in).means[i], (in).log_scales[i],                                                                   \
-        Eigen::Vector4f((in).quats[i][0], (in).quats[i][1], (in).quats[i][2], (in).quats[i][3]), (in).logits[i], \
-        LaneSh<kLanes> { (in).sh + (l) }                                                                 \
+#define RRG_LANE_GAUSSIAN(in, i, l)                                                                 \
+  GaussianInT<float, Eigen::Vector3f, LaneSh<kLanes>> {                                              \
+    (in).means[i], (in).log_scales[i],                                                               \
+        Eigen::Vector4f((in).quats[i][0], (in).quats[i][1], (in).quats[i][2], (in).quats[i][3]),     \
+        (in).logits[i], LaneSh<kLanes> { (in).sh + (l) }                                             \
   }
 
 template <int D>
@@ -42,12 +42,12 @@ LaneInputs lane_inputs(const GaussianViews& g, int64_t i0, int sh_stride, float*
   return {g.means.data, g.log_scales.data, g.quats.data, g.logit_opacities.data, sh};
 }
 
-// Gaussians [i0, i0 + kLanes) of g projected side by side: the loop over the lanes
-// is straight-line project_gaussian (no early return; SH degree D a constant, so the SH sums are
-// unrolled), which GCC turns into 8-wide vector code. The SH rows are first copied lane-major
-// (LaneSh): read in place, eight rows 16 coefficients apart are a gather GCC does not vectorise.
-// A block whose centres are all out of reach (most of a map larger than the view) skips the vector
-// loop.
+// Gaussians [i0, i0 + kLanes) of g projected side by side: the loop over the lanes is
+// straight-line project_gaussian (no early return; SH degree D a constant, so the SH sums are
+// unrolled), which GCC turns into 8-wide vector code once every call in it is inlined
+// (core/CMakeLists.txt raises GCC's inlining limits for this file). `GCC ivdep`, not `omp simd`:
+// OpenMP's per-lane copies of the loop's local records stay in memory and keep it scalar. A block
+// whose centres are all out of reach (most of a map larger than the view) skips the vector loop.
 template <int D>
 void project_block(const View& view, const GaussianViews& g, int64_t i0, Splat* splats, TileRect* rects) {
   bool any = false;
