@@ -100,18 +100,13 @@ template <int D>
 void project_lanes(const View& view, const GaussianViews& g, Span<Splat> splats, Span<TileRect> rects) {
   const int64_t n = g.means.size, blocks = n / kLanes;
   parallel_for(CpuBackend{}, blocks, [&](int64_t b) { project_block<D>(view, g, b * kLanes, splats.data, rects.data); });
-  for (int64_t i = blocks * kLanes; i < n; ++i) {
-    Splat s{};
-    float radius = 0;
-    if (!centre_in_reach(view, g.means[i]) ||
-        !project_gaussian(view, gaussian_at<Eigen::Vector3f>(g, i, view.sh_stride), D, s, radius)) {
-      splats[i] = Splat{};
-      rects[i] = TileRect{};
-      continue;
-    }
-    splats[i] = s;
-    rects[i] = tile_rect(view, s, radius);
-  }
+  if (blocks * kLanes == n) return;
+  // the last n % kLanes one at a time: the per-Gaussian loop over views of them
+  const int64_t i0 = blocks * kLanes, m = n - i0, k = view.sh_stride;
+  auto tail = [&](auto span, int64_t per) { return decltype(span){span.data + i0 * per, m * per}; };
+  const GaussianViews gt{tail(g.means, 1), tail(g.log_scales, 1), tail(g.quats, 1), tail(g.logit_opacities, 1),
+                         tail(g.sh, k), tail(g.plane_ids, 1)};
+  project_splats(CpuBackend{}, view, gt, tail(splats, 1), tail(rects, 1));
 }
 
 // Gradients of Gaussians [i0, i0 + kLanes) side by side, as project_block: project_gaussian_bwd in
