@@ -93,17 +93,28 @@ GaussianHost GaussianSet::to_host() const {
 
 GaussianSet GaussianSet::copy() const {
   GaussianSet out(sh_degree_, device_, size_);
-  const auto same = [&](auto& dst, const auto& src, size_t count) {
-    mem::copy(dst.data(), device_, src.data(), device_, count * sizeof(*src.data()));
-  };
-  same(out.means_, means_, size_);
-  same(out.log_scales_, log_scales_, size_);
-  same(out.quats_, quats_, size_);
-  same(out.logit_opacities_, logit_opacities_, size_);
-  same(out.sh_, sh_, size_ * size_t(sh_coeffs()));
-  same(out.plane_ids_, plane_ids_, size_);
-  out.size_ = size_;
+  out.assign(*this);
   return out;
+}
+
+void GaussianSet::assign(const GaussianSet& src) {
+  if (&src == this) return;
+  if (src.sh_degree_ != sh_degree_ || !(src.device_ == device_))
+    throw std::invalid_argument("GaussianSet::assign: the source has SH degree " + std::to_string(src.sh_degree_) +
+                                " on " + src.device_.to_string() + ", this set " + std::to_string(sh_degree_) + " on " +
+                                device_.to_string());
+  size_ = 0;  // nothing to keep: reserve() then regrows without copying
+  if (src.size_ > capacity_) reserve(std::max(src.size_, src.capacity_));  // grows as the source grew
+  const auto same = [&](auto& dst, const auto& from, size_t count) {
+    mem::copy(dst.data(), device_, from.data(), device_, count * sizeof(*from.data()));
+  };
+  same(means_, src.means_, src.size_);
+  same(log_scales_, src.log_scales_, src.size_);
+  same(quats_, src.quats_, src.size_);
+  same(logit_opacities_, src.logit_opacities_, src.size_);
+  same(sh_, src.sh_, src.size_ * size_t(sh_coeffs()));
+  same(plane_ids_, src.plane_ids_, src.size_);
+  size_ = src.size_;
 }
 
 void GaussianSet::reserve(size_t n) {

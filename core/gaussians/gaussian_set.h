@@ -56,6 +56,9 @@ class GaussianSet {
   GaussianHost to_host() const;
   // An independent copy on the same device (device to device; capacity = size()).
   GaussianSet copy() const;
+  // Makes this set a copy of src (same SH degree and device), reusing this set's buffers when their
+  // capacity suffices: a snapshot refreshed every mapping step allocates (and faults in) nothing new.
+  void assign(const GaussianSet& src);
 
   size_t size() const { return size_; }
   size_t capacity() const { return capacity_; }

@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <numeric>
@@ -326,11 +327,29 @@ MappingStats GaussianMapper::step(const MappingContext& ctx) {
 }
 
 void GaussianMapper::publish() {
-  // Device-to-device copies (no round trip through the host, which on CUDA crossed PCIe twice).
-  auto snap = std::make_shared<MapSnapshot>(
-      MapSnapshot{base_.copy(), refl_.copy(), 0, distinct_planes(refl_)});
+  // Device-to-device copies (no round trip through the host, which on CUDA crossed PCIe twice) into
+  // the snapshot before the current one when no reader holds it any more: its buffers are reused,
+  // so a step publishes without allocating (tens of MB, page-faulted in anew on the CPU each time).
+  std::shared_ptr<MapSnapshot> snap;
+  {
+    std::lock_guard lock(snapshot_mutex_);
+    snap = std::move(spare_);
+  }
+  // No other owner can appear: spare_ is never handed out. The fence orders the last reader's
+  // release (its reference count decrement) before our writes.
+  const bool reusable = snap && snap.use_count() == 1 && snap->base.sh_degree() == base_.sh_degree() &&
+                        snap->reflection.sh_degree() == refl_.sh_degree() && snap->base.device() == device_;
+  if (reusable) {
+    std::atomic_thread_fence(std::memory_order_acquire);
+    snap->base.assign(base_);
+    snap->reflection.assign(refl_);
+    snap->reflection_planes = distinct_planes(refl_);
+  } else {
+    snap = std::make_shared<MapSnapshot>(MapSnapshot{base_.copy(), refl_.copy(), 0, distinct_planes(refl_)});
+  }
   std::lock_guard lock(snapshot_mutex_);
   snap->version = ++version_;
+  spare_ = std::move(snapshot_);
   snapshot_ = std::move(snap);
 }
 

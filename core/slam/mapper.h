@@ -113,7 +113,7 @@ struct MappingStats {
   double ms_raycast = 0, ms_densify = 0, ms_optimise = 0, ms_prune = 0, ms_total = 0;
 };
 
-struct MapSnapshot {             // immutable once published
+struct MapSnapshot {             // immutable for its readers (publish() reuses it once none holds it)
   GaussianSet base, reflection;
   uint64_t version = 0;            // number of published steps / loads
   std::vector<int32_t> reflection_planes;  // the distinct non-zero plane ids l of `reflection`, sorted
@@ -178,7 +178,8 @@ class GaussianMapper {
 
   mutable std::mutex step_mutex_;
   mutable std::mutex snapshot_mutex_;
-  std::shared_ptr<const MapSnapshot> snapshot_;
+  std::shared_ptr<MapSnapshot> snapshot_;  // handed out as const
+  std::shared_ptr<MapSnapshot> spare_;     // the one before: publish() refills it once no reader holds it
   uint64_t version_ = 0;
 
   mutable std::mutex render_mutex_;

@@ -80,6 +80,37 @@ TEST(GaussianSet, CopyIsEqualAndIndependentOnEveryDevice) {
   }
 }
 
+// assign() copies into the set's own buffers while they are large enough (no new allocation), grows
+// them when not, and refuses a source of another SH degree.
+TEST(GaussianSet, AssignReusesCapacityOnEveryDevice) {
+  for (const Device& d : available_devices()) {
+    SCOPED_TRACE(d.to_string());
+    GaussianSet dst = GaussianSet::from_host(tagged(50, 3, 500), d);
+    const Eigen::Vector3f* storage = dst.means().data;
+    const GaussianSet small = GaussianSet::from_host(tagged(20, 3), d);
+    dst.assign(small);
+    EXPECT_EQ(dst.size(), 20u);
+    EXPECT_EQ(dst.capacity(), 50u);
+    EXPECT_EQ(dst.means().data, storage);  // refilled in place
+    GaussianHost got = dst.to_host();
+    EXPECT_EQ(got.means, small.to_host().means);
+    EXPECT_EQ(got.sh, small.to_host().sh);
+    expect_consistent(got);
+    const GaussianSet big = GaussianSet::from_host(tagged(80, 3, 1000), d);
+    dst.assign(big);  // grows
+    EXPECT_EQ(dst.size(), 80u);
+    EXPECT_GE(dst.capacity(), 80u);
+    got = dst.to_host();
+    EXPECT_EQ(got.plane_ids, big.to_host().plane_ids);
+    EXPECT_EQ(got.quats, big.to_host().quats);
+    expect_consistent(got);
+    dst.assign(dst);  // self: unchanged
+    EXPECT_EQ(dst.to_host().means, got.means);
+    EXPECT_THROW(dst.assign(GaussianSet(1, d)), std::invalid_argument);
+    EXPECT_EQ(dst.size(), 80u);  // a refused assign leaves the set as it was
+  }
+}
+
 TEST(GaussianSet, AppendGrowsGeometricallyAndKeepsStorageWithinCapacity) {
   GaussianSet s(1, Device::cpu());
   s.append(tagged(100, 1));

@@ -268,6 +268,39 @@ TEST(Mapper, ReflectionsImproveTheMirrorOnNovelViews) {
   EXPECT_GE(psnr_with - psnr_without, 1.0);
 }
 
+// Publishing refills the snapshot before the current one only when no reader holds it: a held
+// snapshot never changes under its reader, an unheld one is reused (no new allocation per step).
+TEST(Mapper, PublishReusesOnlySnapshotsNoReaderHolds) {
+  MapperParams p;
+  p.sh_degree = 1;
+  const Intrinsics K{40, 40, 16, 12, 32, 24};
+  GaussianMapper m(p, K, Device::cpu());
+  const auto set = [](int n, float tag) {
+    GaussianHost g(1);
+    g.resize(size_t(n));
+    for (int i = 0; i < n; ++i) g.means[size_t(i)] = Eigen::Vector3f(tag, float(i), 1.0f);
+    return g;
+  };
+  m.load(set(30, 1.0f), set(5, 1.5f));
+  const auto held = m.snapshot();  // a reader keeps version 2 (construction, load)
+  m.load(set(30, 2.0f), set(5, 2.5f));
+  const MapSnapshot* second = m.snapshot().get();  // not held
+  m.load(set(30, 3.0f), set(5, 3.5f));  // the held one is not reused: a new snapshot
+  EXPECT_NE(m.snapshot().get(), held.get());
+  m.load(set(20, 4.0f), set(4, 4.5f));  // the unheld second one is refilled
+  const auto now = m.snapshot();
+  EXPECT_EQ(now.get(), second);
+  EXPECT_EQ(now->version, 5u);
+  EXPECT_EQ(now->base.size(), 20u);
+  EXPECT_EQ(now->base.to_host().means, set(20, 4.0f).means);
+  EXPECT_EQ(now->reflection.to_host().means, set(4, 4.5f).means);
+  EXPECT_EQ(held->version, 2u);  // the reader's snapshot is as it was published
+  EXPECT_EQ(held->base.to_host().means, set(30, 1.0f).means);
+  EXPECT_EQ(held->reflection.to_host().means, set(5, 1.5f).means);
+  m.step(MappingContext{.raycast = [&](const Intrinsics&, const Eigen::Isometry3f&) { return RaycastResult{}; }});
+  EXPECT_EQ(m.snapshot()->base.to_host().means, set(20, 4.0f).means);  // a step without frames republishes
+}
+
 TEST(Mapper, ShowsAnyPlaneAndDistinctPlanes) {
   EXPECT_EQ(distinct_planes(std::vector<int32_t>{7, 0, 3, 7, 3, 0, 12}), (std::vector<int32_t>{3, 7, 12}));
   EXPECT_TRUE(distinct_planes(std::vector<int32_t>{0, 0}).empty());
