@@ -12,7 +12,9 @@
 // and its backward reads them instead of evaluating the exponential again. Pass 2's forward also
 // evaluates a splat on eight pixels of a row at once (a vectorised lane loop over the same
 // blend_device.h functions, written without branches for that); its images are the per-pixel
-// loop's bit for bit.
+// loop's bit for bit. The backward takes the same eight-pixel lanes (base_splat_grad_terms), sums
+// each gradient field per lane over the splat's pixels and then across the lanes: a fixed order,
+// whether the falloffs were kept or are evaluated again.
 #include "core/common/parallel_for.h"
 #include "core/render/rasterize_impl.h"
 
@@ -73,6 +75,17 @@ bool reach(const PixelRect& splat, const TilePixels& t, PixelRect& out) {
   return out.x0 < out.x1 && out.y0 < out.y1;
 }
 
+// A tile's list names its splats in depth order, scattered over the splat arrays (megabytes for a
+// trained map): the loops over a list request the records of the entry kPrefetchAhead places on,
+// so that their cache misses overlap the work on the entries before it.
+constexpr int kPrefetchAhead = 8;
+
+template <class T>
+void prefetch_record(const T* p) {
+  RRG_PREFETCH(p);
+  RRG_PREFETCH(reinterpret_cast<const char*>(p) + sizeof(T) - 1);  // a record may straddle two lines
+}
+
 // f(k, g, splat, pixels) for every entry k of the tile's list, in list order, whose splat g reaches
 // the tile; pixels is the part of the tile within its reach. Stops early when more() turns false.
 template <class More, class F>
@@ -80,6 +93,11 @@ void for_each_reaching_splat(const BinViews& bins, Span<const Splat> splats, con
                              int tile, const TilePixels& tp, More more, F f) {
   const TileRange r = bins.ranges[tile];
   for (int32_t k = r.begin; k < r.end && more(); ++k) {
+    if (k + kPrefetchAhead < r.end) {
+      const int32_t ahead = bins.values[k + kPrefetchAhead];
+      prefetch_record(&bounds[size_t(ahead)]);
+      prefetch_record(&splats[ahead]);
+    }
     const int32_t g = bins.values[k];
     PixelRect p;
     if (reach(bounds[size_t(g)], tp, p)) f(k, g, splats[g], p);
@@ -105,6 +123,7 @@ void base_pairs(const View& v, const BinViews& bins, CpuRasterScratch& s) {
     const TileRange r = bins.ranges[t];
     int64_t n = 0;
     for (int32_t k = r.begin; k < r.end; ++k) {
+      if (k + kPrefetchAhead < r.end) prefetch_record(&s.reach[size_t(bins.values[k + kPrefetchAhead])]);
       PixelRect p;
       if (reach(s.reach[size_t(bins.values[k])], tp, p)) n += int64_t(p.x1 - p.x0) * (p.y1 - p.y0);
     }
@@ -221,39 +240,86 @@ void base_bwd_cpu(BaseBwdArgs a, CpuRasterScratch& scratch) {
   for_each_tile(a.view, [&](int tile) {
     clear_entries(a.bins, tile, entries);
     const TilePixels tp = tile_pixels(a.view, tile);
-    BaseUpstreamT<float> up[kTilePixels];
-    float D_t[kTilePixels];
-    bool active[kTilePixels] = {};
+    LaneTile<5> up;  // v_C_g (3), v_W_g, v_D_g; 0 at pixels without upstream gradient (they add 0)
+    LaneTile<1> D_t;
     bool any = false;
     for (int y = tp.y0; y < tp.y1; ++y)
       for (int x = tp.x0; x < tp.x1; ++x) {
-        const int l = tp.local(x, y);
         const Vec3<float> v_C_b = a.v_C_b(x, y);
         const float v_D_b = a.v_D_b(x, y);
+        D_t.at(0, tp, x, y) = a.D_t(x, y);
         if (v_C_b.isZero() && v_D_b == 0.0f) continue;
-        active[l] = any = true;
-        D_t[l] = a.D_t(x, y);
-        up[l] = base_resolve_bwd(a.W_g(x, y), D_t[l], Vec3<float>(a.C_b(x, y)), a.D_b(x, y), v_C_b, v_D_b);
+        any = true;
+        const BaseUpstreamT<float> u =
+            base_resolve_bwd(a.W_g(x, y), D_t.at(0, tp, x, y), Vec3<float>(a.C_b(x, y)), a.D_b(x, y), v_C_b, v_D_b);
+        up.at(0, tp, x, y) = u.v_C_g[0];
+        up.at(1, tp, x, y) = u.v_C_g[1];
+        up.at(2, tp, x, y) = u.v_C_g[2];
+        up.at(3, tp, x, y) = u.v_W_g;
+        up.at(4, tp, x, y) = u.v_D_g;
       }
     if (!any) return;
-    // The forward's falloffs of this tile's pairs, in the same visiting order: alpha and the
-    // gradient from them are those base_splat_bwd would compute, bit for bit.
+    // A splat's gradient terms on eight pixels of a row at once (base_splat_grad_terms), summed per
+    // lane over its pixels and then across the lanes. Its falloffs are the forward's, read back in
+    // the forward's visiting order, or evaluated again the same way when they were not kept; either
+    // way the same alphas and the same sums, bit for bit.
     const float* G = kept ? scratch.G.data() + scratch.pair_offset[size_t(tile)] : nullptr;
-    const auto splat_bwd = [&](int32_t k, int32_t, const Splat& s, const PixelRect& p) {
-      SplatGrad v{};
+    const auto splat_bwd = [&](int32_t k, int32_t, const Splat& splat, const PixelRect& p) {
+      const Splat s = splat;  // local copies: the lane loop reads no memory through references
+      const float eps = a.eps;
+      static_assert(sizeof(SplatGrad) == 10 * sizeof(float));
+      alignas(32) float sum[10][kLanes] = {};  // per field of SplatGrad (mean, conic, opacity, colour, depth), per lane
       for (int y = p.y0; y < p.y1; ++y)
-        for (int x = p.x0; x < p.x1; ++x) {
-          const int l = tp.local(x, y);
-          if (!kept) {
-            if (active[l]) base_splat_bwd(s, float(x), float(y), D_t[l], a.eps, up[l], v);
-            continue;
+        for (int x0 = p.x0; x0 < p.x1; x0 += kLanes) {
+          const int n = std::min(kLanes, p.x1 - x0);
+          const int l0 = LaneTile<1>::index(tp, x0, y);
+          const float* __restrict U0 = up.field(0) + l0;
+          const float* __restrict U1 = up.field(1) + l0;
+          const float* __restrict U2 = up.field(2) + l0;
+          const float* __restrict UW = up.field(3) + l0;
+          const float* __restrict UD = up.field(4) + l0;
+          const float* __restrict Dt = D_t.field(0) + l0;
+          alignas(32) float g[kLanes] = {};
+          if (kept) {
+            std::memcpy(g, G, size_t(n) * sizeof(float));
+            G += n;
+          } else {
+#pragma omp simd
+            for (int i = 0; i < kLanes; ++i) {
+              const float G_i = base_falloff_G(s, s.mean[0] - float(x0 + i), s.mean[1] - float(y), Dt[i], eps);
+              g[i] = i < n && base_alpha(s, G_i) != 0.0f ? G_i : 0.0f;  // as the forward keeps it
+            }
           }
-          const float g = *G++;
-          if (g == 0.0f || !active[l]) continue;
-          const SplatFalloffT<float> f{s.mean[0] - float(x), s.mean[1] - float(y), g, true};
-          base_splat_bwd(s, f, splat_alpha(s, f, 1.0f), up[l], v);
+#pragma GCC ivdep  // not omp simd: OpenMP keeps the per-lane record d in memory, and the loop scalar
+          for (int i = 0; i < kLanes; ++i) {
+            const float alpha = base_alpha(s, g[i]);  // 0 where g = 0: no contribution
+            SplatGrad d;
+            base_splat_grad_terms(s, s.mean[0] - float(x0 + i), s.mean[1] - float(y), g[i], alpha, U0[i], U1[i], U2[i],
+                                  UW[i], UD[i], d);
+            // g = 0 (no alpha here) makes every term +-0, which leaves the sums as they are.
+            sum[0][i] += d.mean[0];
+            sum[1][i] += d.mean[1];
+            sum[2][i] += d.conic[0];
+            sum[3][i] += d.conic[1];
+            sum[4][i] += d.conic[2];
+            sum[5][i] += d.opacity;
+            sum[6][i] += d.color[0];
+            sum[7][i] += d.color[1];
+            sum[8][i] += d.color[2];
+            sum[9][i] += d.depth;
+          }
         }
-      entries[size_t(k)] = v;
+      const auto total = [&](int f) {
+        float t = 0.0f;
+        for (int i = 0; i < kLanes; ++i) t += sum[f][i];
+        return t;
+      };
+      SplatGrad& v = entries[size_t(k)];
+      v.mean[0] = total(0), v.mean[1] = total(1);
+      v.conic[0] = total(2), v.conic[1] = total(3), v.conic[2] = total(4);
+      v.opacity = total(5);
+      v.color[0] = total(6), v.color[1] = total(7), v.color[2] = total(8);
+      v.depth = total(9);
     };
     for_each_reaching_splat(a.bins, a.splats, scratch.reach, tile, tp, [] { return true; }, splat_bwd);
   });
