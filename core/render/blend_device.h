@@ -226,41 +226,15 @@ RRG_HD inline BaseUpstreamT<T> base_resolve_bwd(T W_g, T D_t, const Vec3<T>& C_b
   return u;
 }
 
-// The terms of the gradient of splat s's contribution alpha (non-zero) with falloff G at offset
-// (dx, dy) from a pixel whose accumulators have upstream u = (v_C_g, v_W_g, v_D_g), field by field
-// into d: colour and depth always; opacity, conic and mean through alpha, 0 where alpha is clamped
-// (opacity G > 1: constant). Straight-line, so the CPU lane loop of the backward evaluates it on
-// eight pixels at once; base_splat_bwd adds it into a splat's gradient.
-template <class T>
-RRG_HD inline void base_splat_grad_terms(const SplatT<T>& s, T dx, T dy, T G, T alpha, T vC0, T vC1, T vC2, T vW,
-                                         T vD, SplatT<T>& d) {
-  const T v_alpha = vC0 * s.color[0] + vC1 * s.color[1] + vC2 * s.color[2] + vW + vD * s.depth;
-  d.color[0] = alpha * vC0;
-  d.color[1] = alpha * vC1;
-  d.color[2] = alpha * vC2;
-  d.depth = alpha * vD;
-  const bool through_alpha = !(s.opacity * G > T(1));  // splat_alpha_bwd with alpha_max = 1
-  const T v_power = s.opacity * G * v_alpha;
-  d.opacity = through_alpha ? G * v_alpha : T(0);
-  d.conic[0] = through_alpha ? T(-0.5) * dx * dx * v_power : T(0);
-  d.conic[1] = through_alpha ? -dx * dy * v_power : T(0);
-  d.conic[2] = through_alpha ? T(-0.5) * dy * dy * v_power : T(0);
-  d.mean[0] = through_alpha ? -(s.conic[0] * dx + s.conic[1] * dy) * v_power : T(0);
-  d.mean[1] = through_alpha ? -(s.conic[1] * dx + s.conic[2] * dy) * v_power : T(0);
-}
-
 // Gradient into v of splat s's contribution alpha (non-zero) with falloff f at a pixel.
 template <class T>
 RRG_HD inline void base_splat_bwd(const SplatT<T>& s, const SplatFalloffT<T>& f, T alpha, const BaseUpstreamT<T>& u,
                                   SplatT<T>& v) {
-  SplatT<T> d;
-  base_splat_grad_terms(s, f.dx, f.dy, f.G, alpha, u.v_C_g[0], u.v_C_g[1], u.v_C_g[2], u.v_W_g, u.v_D_g, d);
-  v.mean[0] += d.mean[0];
-  v.mean[1] += d.mean[1];
-  for (int k = 0; k < 3; ++k) v.conic[k] += d.conic[k];
-  v.opacity += d.opacity;
-  for (int ch = 0; ch < 3; ++ch) v.color[ch] += d.color[ch];
-  v.depth += d.depth;
+  const Vec3<T> c(s.color[0], s.color[1], s.color[2]);
+  const T v_alpha = u.v_C_g.dot(c) + u.v_W_g + u.v_D_g * s.depth;
+  for (int ch = 0; ch < 3; ++ch) v.color[ch] += alpha * u.v_C_g[ch];
+  v.depth += alpha * u.v_D_g;
+  splat_alpha_bwd(s, f, T(1), v_alpha, v);
 }
 
 // Gradient of splat s's contribution at (px, py) into v.

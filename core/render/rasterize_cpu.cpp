@@ -12,9 +12,8 @@
 // and its backward reads them instead of evaluating the exponential again. Pass 2's forward also
 // evaluates a splat on eight pixels of a row at once (a vectorised lane loop over the same
 // blend_device.h functions, written without branches for that); its images are the per-pixel
-// loop's bit for bit. The backward takes the same eight-pixel lanes (base_splat_grad_terms), sums
-// each gradient field per lane over the splat's pixels and then across the lanes: a fixed order,
-// whether the falloffs were kept or are evaluated again.
+// loop's bit for bit. (The backward stays scalar: in lanes it was no faster, twice; its time goes to
+// fetching the scattered splat records, not to arithmetic. bench/RESULTS.md, fifteenth session.)
 #include "core/common/parallel_for.h"
 #include "core/render/rasterize_impl.h"
 
@@ -240,86 +239,39 @@ void base_bwd_cpu(BaseBwdArgs a, CpuRasterScratch& scratch) {
   for_each_tile(a.view, [&](int tile) {
     clear_entries(a.bins, tile, entries);
     const TilePixels tp = tile_pixels(a.view, tile);
-    LaneTile<5> up;  // v_C_g (3), v_W_g, v_D_g; 0 at pixels without upstream gradient (they add 0)
-    LaneTile<1> D_t;
+    BaseUpstreamT<float> up[kTilePixels];
+    float D_t[kTilePixels];
+    bool active[kTilePixels] = {};
     bool any = false;
     for (int y = tp.y0; y < tp.y1; ++y)
       for (int x = tp.x0; x < tp.x1; ++x) {
+        const int l = tp.local(x, y);
         const Vec3<float> v_C_b = a.v_C_b(x, y);
         const float v_D_b = a.v_D_b(x, y);
-        D_t.at(0, tp, x, y) = a.D_t(x, y);
         if (v_C_b.isZero() && v_D_b == 0.0f) continue;
-        any = true;
-        const BaseUpstreamT<float> u =
-            base_resolve_bwd(a.W_g(x, y), D_t.at(0, tp, x, y), Vec3<float>(a.C_b(x, y)), a.D_b(x, y), v_C_b, v_D_b);
-        up.at(0, tp, x, y) = u.v_C_g[0];
-        up.at(1, tp, x, y) = u.v_C_g[1];
-        up.at(2, tp, x, y) = u.v_C_g[2];
-        up.at(3, tp, x, y) = u.v_W_g;
-        up.at(4, tp, x, y) = u.v_D_g;
+        active[l] = any = true;
+        D_t[l] = a.D_t(x, y);
+        up[l] = base_resolve_bwd(a.W_g(x, y), D_t[l], Vec3<float>(a.C_b(x, y)), a.D_b(x, y), v_C_b, v_D_b);
       }
     if (!any) return;
-    // A splat's gradient terms on eight pixels of a row at once (base_splat_grad_terms), summed per
-    // lane over its pixels and then across the lanes. Its falloffs are the forward's, read back in
-    // the forward's visiting order, or evaluated again the same way when they were not kept; either
-    // way the same alphas and the same sums, bit for bit.
+    // The forward's falloffs of this tile's pairs, in the same visiting order: alpha and the
+    // gradient from them are those base_splat_bwd would compute, bit for bit.
     const float* G = kept ? scratch.G.data() + scratch.pair_offset[size_t(tile)] : nullptr;
-    const auto splat_bwd = [&](int32_t k, int32_t, const Splat& splat, const PixelRect& p) {
-      const Splat s = splat;  // local copies: the lane loop reads no memory through references
-      const float eps = a.eps;
-      static_assert(sizeof(SplatGrad) == 10 * sizeof(float));
-      alignas(32) float sum[10][kLanes] = {};  // per field of SplatGrad (mean, conic, opacity, colour, depth), per lane
+    const auto splat_bwd = [&](int32_t k, int32_t, const Splat& s, const PixelRect& p) {
+      SplatGrad v{};
       for (int y = p.y0; y < p.y1; ++y)
-        for (int x0 = p.x0; x0 < p.x1; x0 += kLanes) {
-          const int n = std::min(kLanes, p.x1 - x0);
-          const int l0 = LaneTile<1>::index(tp, x0, y);
-          const float* __restrict U0 = up.field(0) + l0;
-          const float* __restrict U1 = up.field(1) + l0;
-          const float* __restrict U2 = up.field(2) + l0;
-          const float* __restrict UW = up.field(3) + l0;
-          const float* __restrict UD = up.field(4) + l0;
-          const float* __restrict Dt = D_t.field(0) + l0;
-          alignas(32) float g[kLanes] = {};
-          if (kept) {
-            std::memcpy(g, G, size_t(n) * sizeof(float));
-            G += n;
-          } else {
-#pragma omp simd
-            for (int i = 0; i < kLanes; ++i) {
-              const float G_i = base_falloff_G(s, s.mean[0] - float(x0 + i), s.mean[1] - float(y), Dt[i], eps);
-              g[i] = i < n && base_alpha(s, G_i) != 0.0f ? G_i : 0.0f;  // as the forward keeps it
-            }
+        for (int x = p.x0; x < p.x1; ++x) {
+          const int l = tp.local(x, y);
+          if (!kept) {
+            if (active[l]) base_splat_bwd(s, float(x), float(y), D_t[l], a.eps, up[l], v);
+            continue;
           }
-#pragma GCC ivdep  // not omp simd: OpenMP keeps the per-lane record d in memory, and the loop scalar
-          for (int i = 0; i < kLanes; ++i) {
-            const float alpha = base_alpha(s, g[i]);  // 0 where g = 0: no contribution
-            SplatGrad d;
-            base_splat_grad_terms(s, s.mean[0] - float(x0 + i), s.mean[1] - float(y), g[i], alpha, U0[i], U1[i], U2[i],
-                                  UW[i], UD[i], d);
-            // g = 0 (no alpha here) makes every term +-0, which leaves the sums as they are.
-            sum[0][i] += d.mean[0];
-            sum[1][i] += d.mean[1];
-            sum[2][i] += d.conic[0];
-            sum[3][i] += d.conic[1];
-            sum[4][i] += d.conic[2];
-            sum[5][i] += d.opacity;
-            sum[6][i] += d.color[0];
-            sum[7][i] += d.color[1];
-            sum[8][i] += d.color[2];
-            sum[9][i] += d.depth;
-          }
+          const float g = *G++;
+          if (g == 0.0f || !active[l]) continue;
+          const SplatFalloffT<float> f{s.mean[0] - float(x), s.mean[1] - float(y), g, true};
+          base_splat_bwd(s, f, splat_alpha(s, f, 1.0f), up[l], v);
         }
-      const auto total = [&](int f) {
-        float t = 0.0f;
-        for (int i = 0; i < kLanes; ++i) t += sum[f][i];
-        return t;
-      };
-      SplatGrad& v = entries[size_t(k)];
-      v.mean[0] = total(0), v.mean[1] = total(1);
-      v.conic[0] = total(2), v.conic[1] = total(3), v.conic[2] = total(4);
-      v.opacity = total(5);
-      v.color[0] = total(6), v.color[1] = total(7), v.color[2] = total(8);
-      v.depth = total(9);
+      entries[size_t(k)] = v;
     };
     for_each_reaching_splat(a.bins, a.splats, scratch.reach, tile, tp, [] { return true; }, splat_bwd);
   });
