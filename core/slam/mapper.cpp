@@ -189,35 +189,34 @@ std::vector<std::shared_ptr<const GaussianMapper::StoredFrame>> GaussianMapper::
   return out;
 }
 
-MappingStats GaussianMapper::step(const MappingContext& ctx) {
-  std::lock_guard step_lock(step_mutex_);
-  const auto t_start = Clock::now();
-  MappingStats st;
-  if (!ctx.raycast) throw std::invalid_argument("GaussianMapper::step: the context has no raycast function");
-  int64_t newest = -1;
+// A step's frames with pass 1 at each, ready for run(); the selected frames are kept alive here.
+struct GaussianMapper::Prepared {
+  uint64_t step = 0;  // 1-based
+  uint64_t seed = 0;
+  std::vector<std::shared_ptr<const StoredFrame>> selected;
+  std::vector<StepFrame> frames;
+  double ms_raycast = 0;
+};
+
+std::shared_ptr<GaussianMapper::Prepared> GaussianMapper::prepare(const MappingContext& ctx) {
+  if (!ctx.raycast) throw std::invalid_argument("GaussianMapper::prepare: the context has no raycast function");
+  auto p = std::make_shared<Prepared>();
+  size_t n_local = 0;
   {
     std::lock_guard lock(frames_mutex_);
-    if (!recent_.empty()) newest = recent_.back()->index;
+    const int64_t newest = recent_.empty() ? -1 : recent_.back()->index;
+    p->step = ++steps_;
+    p->seed = mix(params_.seed ^ mix(p->step) ^ mix(uint64_t(newest) * 0x100000001b3ull));
+    n_local = std::min(recent_.size(), size_t(params_.n_local));
   }
-  const uint64_t seed = mix(params_.seed ^ mix(steps_ + 1) ^ mix(uint64_t(newest) * 0x100000001b3ull));
-  const size_t n_local = [&] {
-    std::lock_guard lock(frames_mutex_);
-    return std::min(recent_.size(), size_t(params_.n_local));
-  }();
-  const auto selected = select_frames(seed);
-  ++steps_;
-  if (selected.empty()) {
-    publish();
-    st.ms_total = ms_since(t_start);
-    return st;
-  }
+  p->selected = select_frames(p->seed);
 
   // 1. pass 1 and ground truth of every selected frame
-  auto t0 = Clock::now();
-  std::vector<StepFrame> frames(selected.size());
-  for (size_t i = 0; i < selected.size(); ++i) {
-    StepFrame& f = frames[i];
-    f.frame = selected[i].get();
+  const auto t0 = Clock::now();
+  p->frames.resize(p->selected.size());
+  for (size_t i = 0; i < p->selected.size(); ++i) {
+    StepFrame& f = p->frames[i];
+    f.frame = p->selected[i].get();
     f.local = i < n_local;
     f.C_gt_host = f.frame->color();
     f.D_gt_host = f.frame->depth_m();
@@ -225,17 +224,35 @@ MappingStats GaussianMapper::step(const MappingContext& ctx) {
     f.D_gt = DeviceImage<float>::from_host(f.D_gt_host, device_);
     RaycastResult r = ctx.raycast(K_, f.frame->T_wc);
     if (r.depth.width() != K_.width || r.depth.height() != K_.height)
-      throw std::runtime_error("GaussianMapper::step: the raycast returned images of the wrong size");
+      throw std::runtime_error("GaussianMapper::prepare: the raycast returned images of the wrong size");
     if (f.local) {
       f.C_var = r.color_variance.to_host();
       f.R = r.reflection_mask.to_host();
     }
     f.rc = to_inputs(std::move(r), device_);
   }
-  st.ms_raycast = ms_since(t0);
+  p->ms_raycast = ms_since(t0);
+  return p;
+}
+
+MappingStats GaussianMapper::step(const MappingContext& ctx) { return run(prepare(ctx), ctx); }
+
+MappingStats GaussianMapper::run(std::shared_ptr<Prepared> prepared, const MappingContext& ctx) {
+  if (!prepared) throw std::invalid_argument("GaussianMapper::run: no prepared step");
+  std::lock_guard step_lock(step_mutex_);
+  const auto t_start = Clock::now();
+  MappingStats st;
+  st.ms_raycast = prepared->ms_raycast;
+  const uint64_t seed = prepared->seed;
+  std::vector<StepFrame>& frames = prepared->frames;
+  if (frames.empty()) {
+    publish();
+    st.ms_total = ms_since(t_start) + st.ms_raycast;
+    return st;
+  }
 
   // 2. densification on the local frames
-  t0 = Clock::now();
+  auto t0 = Clock::now();
   const bool reflections = params_.reflections && !ctx.planes.empty();
   RenderOutputs out;
   for (StepFrame& f : frames) {
@@ -317,10 +334,10 @@ MappingStats GaussianMapper::step(const MappingContext& ctx) {
   st.reflection_size = int64_t(refl_.size());
 
   publish();
-  st.ms_total = ms_since(t_start);
+  st.ms_total = ms_since(t_start) + st.ms_raycast;  // pass 1 included, on whichever thread it ran
   spdlog::debug("mapping step {}: {} frames, +{} / -{} base ({}), +{} / -{} reflection ({}; pass 3 skipped in {} of {} "
                 "iterations), loss {:.4f}, {:.1f} ms (raycast {:.1f}, densify {:.1f}, optimise {:.1f}, prune {:.1f})",
-                steps_, st.frames, st.base_added, st.base_pruned, st.base_size, st.reflection_added,
+                prepared->step, st.frames, st.base_added, st.base_pruned, st.base_size, st.reflection_added,
                 st.reflection_pruned, st.reflection_size, st.reflection_skipped, st.iterations, st.loss, st.ms_total,
                 st.ms_raycast, st.ms_densify, st.ms_optimise, st.ms_prune);
   return st;
@@ -393,10 +410,10 @@ void GaussianMapper::load(const GaussianHost& base, const GaussianHost& reflecti
 MapperState GaussianMapper::export_state() const {
   std::lock_guard step_lock(step_mutex_);
   MapperState st;
-  st.steps = steps_;
   st.adam_base = adam_base_.to_host();
   st.adam_reflection = adam_refl_.to_host();
   std::lock_guard lock(frames_mutex_);
+  st.steps = steps_;
   std::vector<const StoredFrame*> seen;  // a frame is both recent and a keyframe until the next step
   const auto index_of = [&](const std::shared_ptr<const StoredFrame>& f) {
     const auto it = std::find(seen.begin(), seen.end(), f.get());
@@ -442,8 +459,8 @@ void GaussianMapper::import_state(MapperState st) {
   adam_refl.from_host(st.adam_reflection);
   adam_base_ = std::move(adam_base);
   adam_refl_ = std::move(adam_refl);
-  steps_ = st.steps;
   std::lock_guard lock(frames_mutex_);
+  steps_ = st.steps;
   keyframes_ = std::move(keyframes);
   recent_ = std::move(recent);
 }

@@ -1,6 +1,6 @@
 #pragma once
 // The online Gaussian mapping step (paper §4.2, DESIGN.md §1): every N_o frames the session hands
-// the fused frames to the mapper and calls step():
+// the fused frames to the mapper and runs a step (prepare(): 1 and pass 1; run(): the rest):
 //   1. frames: N_local = 2 evenly sampled from the frames added since the last step (the newest
 //      included) + N_global = 7 random keyframes (seeded: params.seed, step count, newest index);
 //   2. densify base and reflection Gaussians on the N_local frames (core/gaussians/densify.h);
@@ -129,6 +129,13 @@ class GaussianMapper {
   void add_frame(MappingFrame frame, bool keyframe);
   // One mapping step (densify → iterations → prune), then publishes a snapshot. Without any frame
   // (queued or keyframe) it only republishes. Not re-entrant (one step at a time).
+  // step() = run(prepare()). prepare() selects the step's frames (consuming the queued ones) and
+  // runs pass 1 at each through ctx.raycast; it reads no Gaussian, so the session runs it on the
+  // pre-mapping thread while the previous step's run() optimises (docs/slam.md). Prepared steps
+  // must be run in the order they were prepared; run() throws std::invalid_argument for a null one.
+  struct Prepared;
+  std::shared_ptr<Prepared> prepare(const MappingContext& ctx);
+  MappingStats run(std::shared_ptr<Prepared> prepared, const MappingContext& ctx);
   MappingStats step(const MappingContext& ctx);
   // The latest published snapshot (never null). Thread-safe.
   std::shared_ptr<const MapSnapshot> snapshot() const;
@@ -170,7 +177,7 @@ class GaussianMapper {
   GaussianGrads v_base_, v_refl_, v_no_reflection_;
   Renderer renderer_;
   LossScratch loss_scratch_;
-  uint64_t steps_ = 0;
+  uint64_t steps_ = 0;           // steps prepared (guarded by frames_mutex_)
 
   mutable std::mutex frames_mutex_;
   std::deque<std::shared_ptr<const StoredFrame>> recent_;

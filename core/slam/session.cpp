@@ -190,12 +190,24 @@ void Session::Impl::identify(const SessionFrame& frame, const Eigen::Isometry3f&
 // Hands the fused frames to the mapper and runs a step: inline (sync) or on the mapping thread.
 void Session::Impl::schedule_mapping(FrameReport& report) {
   const auto t0 = Clock::now();
-  worker.wait();  // the previous step (async) must be done before the mapper takes new frames
+  // The frames since the last step go to the mapper, and the next step is prepared here: its frames
+  // selected and pass 1 raycast on this (pre-mapping) thread, from the TSDF as fused up to this
+  // frame, while a running step still optimises (it chose its frames when it was prepared). Then
+  // the step's remaining work waits for the running one and goes to the mapping thread (inline
+  // with --sync, in the same order).
   for (size_t i = 0; i < pending.size(); ++i) mapper.add_frame(std::move(pending[i]), pending_keyframe[i]);
   pending.clear();
   pending_keyframe.clear();
-  auto job = [this, ctx = mapping_context()]() {
-    const MappingStats s = mapper.step(ctx);
+  const MappingContext ctx = mapping_context();
+  std::shared_ptr<GaussianMapper::Prepared> prepared = mapper.prepare(ctx);
+  std::exception_ptr failed;  // of the running step: reported after this one starts (its frames are consumed)
+  try {
+    worker.wait();
+  } catch (...) {
+    failed = std::current_exception();
+  }
+  auto job = [this, ctx, prepared = std::move(prepared)]() mutable {
+    const MappingStats s = mapper.run(std::move(prepared), ctx);
     std::lock_guard lock(state_mutex);
     ++mapping.steps;
     mapping.ms_total += s.ms_total;
@@ -215,6 +227,7 @@ void Session::Impl::schedule_mapping(FrameReport& report) {
   }
   report.mapping_started = true;
   report.times.mapping = ms_since(t0);
+  if (failed) std::rethrow_exception(failed);
 }
 
 // --- process -----------------------------------------------------------------------------------------

@@ -125,6 +125,46 @@ TEST(Mapper, StepsAreDeterministicAndKeepTheBooks) {
   EXPECT_THROW(bad.validate(), std::invalid_argument);
 }
 
+// The session prepares step n + 1 (frames chosen, pass 1 raycast) on the pre-mapping thread while
+// step n runs: the same map, bit for bit, as steps taken one after the other.
+TEST(Mapper, StepsPreparedWhileTheLastRunsGiveTheSameMap) {
+  test::MapperSceneParams sp;
+  sp.width = 48;
+  sp.height = 36;
+  sp.frames = 12;
+  const test::MapperScene s = test::make_mapper_scene(sp);
+  MapperParams p;
+  p.iterations = 6;
+  p.sh_degree = 1;
+  GaussianMapper one_by_one(p, s.K, Device::cpu()), overlapped(p, s.K, Device::cpu());
+  std::vector<MappingStats> sa, sb;
+  for (size_t i = 0; i < s.frames.size(); ++i) {
+    one_by_one.add_frame(s.frame(i), i % 4 == 0);
+    if (i % 6 == 5) sa.push_back(one_by_one.step(s.context()));
+  }
+  for (size_t i = 0; i < 6; ++i) overlapped.add_frame(s.frame(i), i % 4 == 0);
+  auto first = overlapped.prepare(s.context());
+  std::thread running([&] { sb.push_back(overlapped.run(std::move(first), s.context())); });
+  for (size_t i = 6; i < 12; ++i) overlapped.add_frame(s.frame(i), i % 4 == 0);  // while step 1 runs
+  auto second = overlapped.prepare(s.context());
+  running.join();
+  sb.push_back(overlapped.run(std::move(second), s.context()));
+  ASSERT_EQ(sa.size(), 2u);
+  ASSERT_EQ(sb.size(), 2u);
+  for (size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(sa[k].loss, sb[k].loss) << k;
+    EXPECT_EQ(sa[k].frames, sb[k].frames) << k;
+    EXPECT_EQ(sa[k].base_size, sb[k].base_size) << k;
+  }
+  const GaussianHost ha = one_by_one.base_host(), hb = overlapped.base_host();
+  EXPECT_GT(ha.size(), 0u);
+  EXPECT_EQ(ha.means, hb.means);
+  EXPECT_EQ(ha.sh, hb.sh);
+  EXPECT_EQ(ha.logit_opacities, hb.logit_opacities);
+  EXPECT_EQ(one_by_one.export_state().steps, overlapped.export_state().steps);
+  EXPECT_THROW(overlapped.run(nullptr, s.context()), std::invalid_argument);
+}
+
 TEST(Mapper, FitsOneViewAbove35dB) {
   // One thread (the result is the same on any number; this keeps the test's time predictable).
   // 128x96, not smaller: at 64x48 a pixel spans 4 cm at 2 m, the fitted Gaussians grow to the
