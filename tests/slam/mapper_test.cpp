@@ -58,15 +58,25 @@ void apply_env_overrides(MapperParams& p) {
   }
 }
 
-TEST(Mapper, StepsAreDeterministicAndKeepTheBooks) {
+// The small scene (48x36, 12 frames) and short steps of the bookkeeping tests.
+test::MapperScene small_scene() {
   test::MapperSceneParams sp;
   sp.width = 48;
   sp.height = 36;
   sp.frames = 12;
-  const test::MapperScene s = test::make_mapper_scene(sp);
+  return test::make_mapper_scene(sp);
+}
+
+MapperParams short_steps() {
   MapperParams p;
   p.iterations = 6;
   p.sh_degree = 1;
+  return p;
+}
+
+TEST(Mapper, StepsAreDeterministicAndKeepTheBooks) {
+  const test::MapperScene s = small_scene();
+  const MapperParams p = short_steps();
   auto run = [&](std::vector<MappingStats>* stats) {
     auto m = std::make_unique<GaussianMapper>(p, s.K, Device::cpu());
     for (size_t i = 0; i < s.frames.size(); ++i) {
@@ -128,14 +138,8 @@ TEST(Mapper, StepsAreDeterministicAndKeepTheBooks) {
 // The session prepares step n + 1 (frames chosen, pass 1 raycast) on the pre-mapping thread while
 // step n runs: the same map, bit for bit, as steps taken one after the other.
 TEST(Mapper, StepsPreparedWhileTheLastRunsGiveTheSameMap) {
-  test::MapperSceneParams sp;
-  sp.width = 48;
-  sp.height = 36;
-  sp.frames = 12;
-  const test::MapperScene s = test::make_mapper_scene(sp);
-  MapperParams p;
-  p.iterations = 6;
-  p.sh_degree = 1;
+  const test::MapperScene s = small_scene();
+  const MapperParams p = short_steps();
   GaussianMapper one_by_one(p, s.K, Device::cpu()), overlapped(p, s.K, Device::cpu());
   std::vector<MappingStats> sa, sb;
   for (size_t i = 0; i < s.frames.size(); ++i) {
