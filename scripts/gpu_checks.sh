@@ -2,25 +2,33 @@
 # The CUDA checks of a lent GPU session (../shared/GPU.md), prepared so that one device call does
 # them all within its few minutes.
 #
-#   scripts/gpu_checks.sh bundle   here: pack the test binaries and benchmarks of build/ (built with
-#                                  -DCMAKE_CUDA_ARCHITECTURES=90 -DRRG_BUILD_BENCH=ON) into .gpu/
+#   scripts/gpu_checks.sh bundle   here: pack the CUDA test binaries, rrg_bench and rrg of build/
+#                                  (built with -DCMAKE_CUDA_ARCHITECTURES=90 -DRRG_BUILD_BENCH=ON)
+#                                  into .gpu/
 #   scripts/gpu_checks.sh device   there, in one `run` call with carry=[".gpu"]:
-#                                    run(command="scripts/gpu_checks.sh device", carry=[".gpu"], timeout_s=540)
+#                                    run(command="scripts/gpu_checks.sh device", carry=[".gpu"], timeout_s=480)
 #
-# On the device, in order of importance, each step under its own time limit so a slow one cannot
-# starve the rest: the CUDA parity tests of the TSDF, renderer, Gaussians, tracking, planes and the
-# session; the CUDA micro-benchmarks; compute-sanitizer on the TSDF tests. Logs go to $OUT/*.txt and
-# a one-line verdict per step to $OUT/summary.txt (and stdout).
+# On the device, in order of importance, each step under its own time limit and all of them under
+# one deadline (GPU_CHECKS_DEADLINE seconds, default 420) so a slow step cannot starve the rest:
+#   1. the CUDA parity tests (TSDF, renderer, Gaussians, tracking, device layer);
+#   2. the whole pipeline on the CUDA back end (`rrg synth` then `rrg run --device cuda`):
+#      living_room and mirror_room 320x240 (300 noisy frames, mirror_room with reflections on and
+#      off), mirror_room 1280x720 (150 frames);
+#   3. the CUDA micro-benchmarks;
+#   4. compute-sanitizer on the TSDF tests.
+# A one-line verdict per step goes to $OUT/summary.txt (and stdout); every log, metrics.json and
+# timings.json goes into $OUT/results.tar.gz (the device tool returns at most 8 files), rewritten
+# after each step so a cut-off run still returns what it did.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 
-tests=(test_tsdf test_render test_gaussians test_tracking test_planes test_common test_slam)
-benches=(rrg_bench)
+tests=(test_tsdf test_render test_gaussians test_tracking test_common)
+tools=(rrg_bench rrg)
 
 case "${1:-}" in
   bundle)
     exes=()
-    for t in "${tests[@]}" "${benches[@]}"; do
+    for t in "${tests[@]}" "${tools[@]}"; do
       [[ -x build/bin/$t ]] || { echo "gpu_checks: build/bin/$t is missing (build with tests and benchmarks first)" >&2; exit 2; }
       exes+=("build/bin/$t")
     done
@@ -30,34 +38,67 @@ case "${1:-}" in
   device)
     : "${OUT:?gpu_checks: device mode writes under \$OUT (the device tool sets it)}"
     [[ -f .gpu/bundle.tar.xz ]] || { echo "gpu_checks: .gpu/bundle.tar.xz not carried" >&2; exit 2; }
-    g=/tmp/g
-    mkdir -p "$g" && tar -C "$g" -xJf .gpu/bundle.tar.xz || exit 2
+    g=/tmp/g logs=/tmp/gpu_logs data=/tmp/gpu_data
+    mkdir -p "$g" "$logs" "$data" && tar -C "$g" -xJf .gpu/bundle.tar.xz || exit 2
     export LD_LIBRARY_PATH=$g/lib PATH=$g/bin:$PATH
-    nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv,noheader | tee "$OUT/device.txt"
+    # the CLI tests run the bundled rrg on the repo's test data (not the build tree's compiled-in paths)
+    export RRG_CLI=$g/bin/rrg RRG_TEST_DATA_DIR=$PWD/tests/data
+    deadline=$((SECONDS + ${GPU_CHECKS_DEADLINE:-420}))
+    { nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv,noheader; nproc; } | tee "$logs/device.txt"
+    pack() { tar -C "$logs" -czf "$OUT/results.tar.gz.part" . && mv "$OUT/results.tar.gz.part" "$OUT/results.tar.gz"; }
     step() {  # step NAME SECONDS COMMAND...
       local name=$1 limit=$2
       shift 2
+      local left=$((deadline - SECONDS))
+      if ((left < 10)); then
+        echo "$name: SKIPPED (deadline)" | tee -a "$OUT/summary.txt"
+        return 1
+      fi
+      ((limit > left)) && limit=$left
       local t0=$SECONDS
-      timeout "$limit" "$@" > "$OUT/$name.txt" 2>&1
+      timeout "$limit" "$@" > "$logs/$name.txt" 2>&1
       local rc=$?
       local verdict="ok"
       ((rc == 124)) && verdict="TIMED OUT after ${limit}s"
       ((rc != 0 && rc != 124)) && verdict="FAILED (rc $rc)"
       echo "$name: $verdict, $((SECONDS - t0)) s" | tee -a "$OUT/summary.txt"
-      grep -E "^\[  FAILED  \]" "$OUT/$name.txt" | head -20 | tee -a "$OUT/summary.txt"
+      grep -E "^\[  FAILED  \]|PASSED|error|Error" "$logs/$name.txt" | head -20 | tee -a "$OUT/summary.txt"
+      pack
+      return $rc
     }
+    run_scene() {  # run_scene NAME DATASET EXTRA_ARGS...
+      local name=$1 dataset=$2
+      shift 2
+      step "$name" 150 rrg run --dataset "$dataset" --out "$data/$name" --device cuda --no-progress "$@"
+      for f in metrics.json timings.json; do
+        [[ -f $data/$name/$f ]] && cp "$data/$name/$f" "$logs/$name.$f"
+      done
+      pack
+    }
+
+    # 1. parity
     step test_tsdf 60 test_tsdf --gtest_brief=1
-    step test_render 60 test_render --gtest_brief=1
-    step test_gaussians 60 test_gaussians --gtest_brief=1
-    step test_tracking 60 test_tracking --gtest_brief=1
-    step test_planes 60 test_planes --gtest_brief=1
-    step test_common 30 test_common --gtest_brief=1
-    step test_slam 120 test_slam --gtest_brief=1
-    step bench_cuda 90 rrg_bench --benchmark_filter='cuda' --benchmark_min_time=0.2
+    step test_render 45 test_render --gtest_brief=1
+    step test_gaussians 30 test_gaussians --gtest_brief=1
+    step test_tracking 45 test_tracking --gtest_brief=1
+    step test_common 20 test_common --gtest_brief=1
+    # 2. the whole pipeline
+    step synth_lr320 30 rrg synth --preset living_room --frames 300 --noise --out "$data/lr320"
+    step synth_mr320 30 rrg synth --preset mirror_room --frames 300 --noise --out "$data/mr320"
+    step synth_mr720 60 rrg synth --preset mirror_room --frames 150 --width 1280 --height 720 \
+      --novel 10 --noise --out "$data/mr720"
+    run_scene run_lr320 "$data/lr320"
+    run_scene run_mr320 "$data/mr320" --ablate-reflections
+    run_scene run_mr720 "$data/mr720"
+    # 3. micro-benchmarks
+    step bench_cuda 60 rrg_bench --benchmark_min_time=0.2 \
+      --benchmark_filter='cuda.*(tsdf_(fuse|raycast)_(640x480|1280x720)/5mm|mapping_step|tracking|vertex)|(tsdf_(fuse|raycast)_(640x480|1280x720)/5mm|mapping_step|tracking|vertex|render).*cuda'
+    # 4. memory errors
     if command -v compute-sanitizer > /dev/null; then
-      step sanitizer_tsdf 90 compute-sanitizer --error-exitcode=1 test_tsdf --gtest_brief=1 \
+      step sanitizer_tsdf 60 compute-sanitizer --error-exitcode=1 test_tsdf --gtest_brief=1 \
         --gtest_filter='TsdfStorage.*:TsdfRaycast.*:TsdfMesh*'
     fi
+    pack
     ;;
   *)
     echo "usage: scripts/gpu_checks.sh bundle|device" >&2

@@ -48,7 +48,7 @@ ServerProcess::ServerProcess(const std::vector<std::string>& extra, const fs::pa
   dir_ = unique_dir("serve");
   log_ = dir_ / "serve.log";
   const fs::path port_file = dir_ / "port";
-  std::vector<std::string> args = {RRG_CLI, "serve", "--address", "127.0.0.1:0", "--device", "cpu",
+  std::vector<std::string> args = {test::rrg_executable().string(), "serve", "--address", "127.0.0.1:0", "--device", "cpu",
                                    "--port-file", port_file.string()};
   if (!snapshot_dir.empty()) args.insert(args.end(), {"--snapshot-dir", snapshot_dir.string()});
   args.insert(args.end(), extra.begin(), extra.end());

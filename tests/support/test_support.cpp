@@ -29,13 +29,23 @@ TempDir::~TempDir() {
 }
 
 namespace {
+// A compiled-in path, unless the environment variable `name` names another (test binaries carried
+// to another machine, e.g. the GPU bundle of scripts/gpu_checks.sh, where the build tree is absent).
+std::filesystem::path overridable(const char* name, const char* compiled_in) {
+  const char* env = std::getenv(name);
+  return env && *env ? std::filesystem::path(env) : std::filesystem::path(compiled_in);
+}
+
 // "<rrg> args" for the shell; throws when the executable is not built.
 std::string rrg_command(const std::string& args) {
-  if (!std::filesystem::exists(RRG_CLI))
-    throw std::runtime_error(std::string("the rrg executable is not built: ") + RRG_CLI);
-  return std::string(RRG_CLI) + " " + args;
+  const std::filesystem::path cli = rrg_executable();
+  if (!std::filesystem::exists(cli))
+    throw std::runtime_error("the rrg executable is not built: " + cli.string() + " (RRG_CLI overrides the path)");
+  return cli.string() + " " + args;
 }
 }  // namespace
+
+std::filesystem::path rrg_executable() { return overridable("RRG_CLI", RRG_CLI); }
 
 CommandResult run_rrg(const std::string& args) { return run_shell(rrg_command(args)); }
 
@@ -96,6 +106,6 @@ int BackgroundRrg::wait() {
   return WIFEXITED(status_) ? WEXITSTATUS(status_) : -1;
 }
 
-std::filesystem::path test_data_dir() { return RRG_TEST_DATA_DIR; }
+std::filesystem::path test_data_dir() { return overridable("RRG_TEST_DATA_DIR", RRG_TEST_DATA_DIR); }
 
 }  // namespace rrg::test

@@ -23,7 +23,9 @@ struct CommandResult {
   int exit_code = -1;
   std::string output;  // stdout and stderr together
 };
-// Runs `rrg <args>` (the freshly built binary) through the shell and captures its output.
+// The freshly built `rrg` (compiled-in path; the environment variable RRG_CLI overrides it).
+std::filesystem::path rrg_executable();
+// Runs `rrg <args>` (rrg_executable()) through the shell and captures its output.
 CommandResult run_rrg(const std::string& args);
 // Runs a shell command line and captures its output the same way (exit code −1 when a signal
 // ended it); `auto [rc, out] = run_shell(...)` reads both.
@@ -48,7 +50,8 @@ class BackgroundRrg {
   std::filesystem::path log_;
 };
 
-// Folder with small committed test inputs (tests/data).
+// Folder with small committed test inputs (tests/data; the environment variable RRG_TEST_DATA_DIR
+// overrides it).
 std::filesystem::path test_data_dir();
 
 }  // namespace rrg::test

@@ -7,7 +7,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <iostream>
 #include <map>
 #include <numbers>
 
@@ -81,16 +83,36 @@ TEST(TsdfMesh, BlocksMeshedSeparatelyWeldToTheWholeMesh) {
   EXPECT_NEAR(parts, area(whole), 1e-6 * area(whole));
 }
 
+// CPU and CUDA give the same mesh: the same triangles, and vertices within 0.2 mm. The back ends'
+// compilers contract multiply-adds differently, so a voxel whose nearest pixel lies exactly at x.5
+// may fuse the neighbouring pixel on one of them (tsdf_fusion_test.cpp allows 0.5 % of the voxels
+// to differ for that reason); the vertices on that voxel's edges then move by a fraction of the
+// pixel's footprint over the voxel's weight: at most 0.1 % of the vertices may differ by more than
+// 0.2 mm (H200, 2026-12-04: 3 of 10k by 0.28 mm), none by more than 1 mm (a tenth of a voxel).
 TEST(TsdfMesh, SameMeshOnEveryDevice) {
-  test::expect_device_parity<float>(
-      [](const Device& device) {
-        const TriangleMesh m = extract_mesh(fused_sphere(device));
-        std::vector<float> out;
-        for (const auto& p : m.vertices) out.insert(out.end(), {p.x(), p.y(), p.z()});
-        for (const auto& t : m.triangles) out.insert(out.end(), {float(t.x()), float(t.y()), float(t.z())});
-        return out;
-      },
-      2e-4, 0.0);
+  test::report_cuda_parity_status();
+  const TriangleMesh cpu = extract_mesh(fused_sphere(Device::cpu()));
+  ASSERT_GT(cpu.vertices.size(), 1000u);
+  for (const Device& device : available_devices()) {
+    if (device.is_cpu()) continue;
+    SCOPED_TRACE(device.to_string());
+    const TriangleMesh gpu = extract_mesh(fused_sphere(device));
+    ASSERT_EQ(gpu.vertices.size(), cpu.vertices.size());
+    ASSERT_EQ(gpu.triangles.size(), cpu.triangles.size());
+    size_t triangles_differ = 0, vertices_differ = 0;
+    float worst = 0.0f;
+    for (size_t i = 0; i < cpu.triangles.size(); ++i) triangles_differ += cpu.triangles[i] != gpu.triangles[i];
+    for (size_t i = 0; i < cpu.vertices.size(); ++i) {
+      const float d = (cpu.vertices[i] - gpu.vertices[i]).cwiseAbs().maxCoeff();
+      vertices_differ += d > 2e-4f;
+      worst = std::max(worst, d);
+    }
+    std::cout << "[parity] mesh: " << vertices_differ << " of " << cpu.vertices.size()
+              << " vertices differ by more than 0.2 mm, largest " << worst * 1e3f << " mm\n";
+    EXPECT_EQ(triangles_differ, 0u);
+    EXPECT_LE(vertices_differ, cpu.vertices.size() / 1000);
+    EXPECT_LE(worst, 1e-3f);
+  }
 }
 
 TEST(TsdfMesh, CaseTableIsClosedAndComplete) {
