@@ -78,7 +78,8 @@ struct RunTimings {
   // Its stages per step: keyframe raycasts, densification, optimisation, pruning.
   double mapping_raycast_ms = 0, mapping_densify_ms = 0, mapping_optimise_ms = 0, mapping_prune_ms = 0;
   int64_t mapping_steps = 0;
-  double load_ms = 0;              // dataset reading, per frame
+  double load_ms = 0;              // dataset reading and decoding, per frame (on the loader threads)
+  double load_wait_ms = 0;         // what the frame loop waited for a loaded frame, per frame
   double premapping_ms = 0;        // raycast + preprocess + icp + orb + fuse + identify, per frame
   double wall_ms_per_frame = 0;
 };
