@@ -16,6 +16,23 @@
 namespace rrg {
 namespace {
 
+// Frames are decoded ahead on loader threads; a frame that cannot be read must still stop the run
+// at that frame, with an error naming the file, after the frames before it were processed.
+TEST(RunCli, AnUnreadableFrameStopsTheRunAndNamesTheFile) {
+  test::TempDir dir("run_cli_bad");
+  const auto seq = dir / "seq";
+  auto r = test::run_rrg("synth --preset living_room --frames 12 --width 160 --height 120 --novel 1 --out " + seq.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto bad = seq / "depth" / "000007.png";
+  ASSERT_TRUE(std::filesystem::exists(bad));
+  std::ofstream(bad, std::ios::trunc) << "not a png";
+  r = test::run_rrg("-v run --dataset " + seq.string() + " --out " + (dir / "run").string() +
+                    " --device cpu --sync --gt-poses --no-progress --set tsdf.voxel_size=0.02 --set tsdf.truncation=0.08");
+  EXPECT_NE(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("000007.png"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "run" / "metrics.json")) << "no metrics for a run that did not finish";
+}
+
 TEST(RunCli, WritesOutputsAndScoresGeometryOnTheObservedSurface) {
   test::TempDir dir("run_cli");
   const auto seq = dir / "seq";
