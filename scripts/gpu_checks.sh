@@ -79,12 +79,13 @@ case "${1:-}" in
       pack
       return $rc
     }
-    run_scene() {  # run_scene [--with EXE] NAME DATASET EXTRA_ARGS...
-      local exe=rrg
+    run_scene() {  # run_scene [--with EXE] [--limit SECONDS] NAME DATASET EXTRA_ARGS...
+      local exe=rrg limit=150
       [[ $1 == --with ]] && { exe=$2; shift 2; }
+      [[ $1 == --limit ]] && { limit=$2; shift 2; }
       local name=$1 dataset=$2
       shift 2
-      step "$name" 150 "$exe" run --dataset "$dataset" --out "$data/$name" --device cuda --no-progress "$@"
+      step "$name" "$limit" "$exe" run --dataset "$dataset" --out "$data/$name" --device cuda --no-progress "$@"
       for f in metrics.json timings.json; do
         [[ -f $data/$name/$f ]] && cp "$data/$name/$f" "$logs/$name.$f"
       done
@@ -106,15 +107,15 @@ case "${1:-}" in
     fi
     step synth_mr640 40 rrg synth --preset mirror_room --frames 300 --width 640 --height 480 --noise \
       --out "$data/mr640"
-    run_scene run_mr640 "$data/mr640" --ablate-reflections
+    run_scene --limit 240 run_mr640 "$data/mr640" --ablate-reflections
     step synth_lr320 30 rrg synth --preset living_room --frames 300 --noise --out "$data/lr320"
     run_scene run_lr320 "$data/lr320"
+    # 3. micro-benchmarks (the host's share too: densification, ORB extraction)
+    [[ -x $g/bin/rrg_bench ]] && step bench 60 rrg_bench --benchmark_min_time=0.2 \
+      --benchmark_filter='densify|orb_extract|cuda.*(tsdf_(fuse|raycast)_(640x480|1280x720)/5mm|mapping_step|tracking|vertex)|(tsdf_(fuse|raycast)_(640x480|1280x720)/5mm|mapping_step|tracking|vertex|render).*cuda'
     step synth_mr320 30 rrg synth --preset mirror_room --frames 300 --noise --out "$data/mr320"
     # the CPU runs' voxels (1 cm, truncation 4 cm), for figures comparable with them
     run_scene run_mr320_1cm "$data/mr320" --ablate-reflections --set tsdf.voxel_size=0.01 --set tsdf.truncation=0.04
-    # 3. micro-benchmarks
-    [[ -x $g/bin/rrg_bench ]] && step bench_cuda 60 rrg_bench --benchmark_min_time=0.2 \
-      --benchmark_filter='cuda.*(tsdf_(fuse|raycast)_(640x480|1280x720)/5mm|mapping_step|tracking|vertex)|(tsdf_(fuse|raycast)_(640x480|1280x720)/5mm|mapping_step|tracking|vertex|render).*cuda'
     # 4. memory errors
     if command -v compute-sanitizer > /dev/null; then
       step sanitizer_tsdf 60 compute-sanitizer --error-exitcode=1 test_tsdf --gtest_brief=1 \
@@ -123,7 +124,7 @@ case "${1:-}" in
     pack
     ;;
   *)
-    echo "usage: scripts/gpu_checks.sh bundle|device" >&2
+    echo "usage: scripts/gpu_checks.sh bundle [BEFORE] | device" >&2
     exit 2
     ;;
 esac
