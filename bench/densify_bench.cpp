@@ -2,7 +2,8 @@
 // that stays on the CPU with either back end: a 1280x720 view in which a mirror (a reflective plane
 // 1.5 m ahead) covers the middle third of the image and nothing is fitted yet, so every sampled
 // mirror pixel becomes ten reflection Gaussians along its ray, and every other pixel with depth a
-// base Gaussian candidate. Reports ms per call and the Gaussians made.
+// base Gaussian candidate. Reports ms per call and the Gaussians made, for batches of SH degree 0
+// (what the mapper makes since the sixteenth session) and 3 (before).
 #include "core/gaussians/densify.h"
 
 #include <benchmark/benchmark.h>
@@ -53,30 +54,33 @@ View make_view() {
   return s;
 }
 
-void BM_densify_reflection(benchmark::State& state) {
+// degree: SH degree of the batch made (the mapper asks for 0, DC only; 3 is the set's degree).
+void BM_densify_reflection(benchmark::State& state, int degree) {
   const View s = make_view();
   const rrg::DensifyParams p;
   size_t made = 0;
   for (auto _ : state) {
-    const rrg::GaussianHost g = rrg::densify_reflection(s.view(), s.planes, p, 3, 42);
+    const rrg::GaussianHost g = rrg::densify_reflection(s.view(), s.planes, p, degree, 42);
     made = g.size();
     benchmark::DoNotOptimize(g.means.data());
   }
   state.counters["gaussians"] = double(made);
 }
-BENCHMARK(BM_densify_reflection)->Name("densify_reflection_1280x720/cpu")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_densify_reflection, sh0, 0)->Name("densify_reflection_1280x720/sh0/cpu")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_densify_reflection, sh3, 3)->Name("densify_reflection_1280x720/sh3/cpu")->Unit(benchmark::kMillisecond)->UseRealTime();
 
-void BM_densify_base(benchmark::State& state) {
+void BM_densify_base(benchmark::State& state, int degree) {
   const View s = make_view();
   const rrg::DensifyParams p;
   size_t made = 0;
   for (auto _ : state) {
-    const rrg::GaussianHost g = rrg::densify_base(s.view(), p, 3, 42);
+    const rrg::GaussianHost g = rrg::densify_base(s.view(), p, degree, 42);
     made = g.size();
     benchmark::DoNotOptimize(g.means.data());
   }
   state.counters["gaussians"] = double(made);
 }
-BENCHMARK(BM_densify_base)->Name("densify_base_1280x720/cpu")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_densify_base, sh0, 0)->Name("densify_base_1280x720/sh0/cpu")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_densify_base, sh3, 3)->Name("densify_base_1280x720/sh3/cpu")->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace

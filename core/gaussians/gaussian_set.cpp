@@ -131,9 +131,9 @@ void GaussianSet::reserve(size_t n) {
 
 void GaussianSet::append(const GaussianHost& batch) {
   batch.validate();
-  if (batch.sh_degree != sh_degree_)
+  if (batch.sh_degree > sh_degree_)
     throw std::invalid_argument("GaussianSet::append: batch SH degree " + std::to_string(batch.sh_degree) +
-                                " != set SH degree " + std::to_string(sh_degree_));
+                                " > set SH degree " + std::to_string(sh_degree_));
   const size_t n = size_ + batch.size();
   if (n > capacity_) reserve(std::max(n, capacity_ + capacity_ / 2));
   const size_t k = size_t(sh_coeffs());
@@ -141,7 +141,17 @@ void GaussianSet::append(const GaussianHost& batch) {
   upload(log_scales_, size_, batch.log_scales);
   upload(quats_, size_, batch.quats);
   upload(logit_opacities_, size_, batch.logit_opacities);
-  upload(sh_, size_ * k, batch.sh);
+  if (batch.sh_degree == sh_degree_) {
+    upload(sh_, size_ * k, batch.sh);
+  } else if (batch.size() > 0) {
+    // Only the batch's bands travel; the higher ones are zeroed where they land.
+    const auto src = Buffer<Eigen::Vector3f>::from_host(batch.sh, device_);
+    const Span<Eigen::Vector3f> dst{sh_.data() + size_ * k, int64_t(batch.size() * k)};
+    const int from = batch.sh_coeffs(), to = int(k);
+    const int64_t m = int64_t(batch.size());
+    RRG_DISPATCH(device_, kernel::pad_sh_rows_cpu(dst, to, src.span(), from, m),
+                 kernel::pad_sh_rows_cuda(dst, to, src.span(), from, m));
+  }
   upload(plane_ids_, size_, batch.plane_ids);
   size_ = n;
 }

@@ -68,7 +68,10 @@ class GaussianSet {
 
   // Ensures capacity >= n without changing size (one reallocation, contents kept).
   void reserve(size_t n);
-  // Appends host Gaussians (same SH degree); capacity grows by at least 1.5x when exceeded.
+  // Appends host Gaussians of this set's SH degree or a lower one (their higher bands are then zero:
+  // new Gaussians start with only the bands they were made with, and the zeros are written on the
+  // set's device rather than built and copied on the host); capacity grows by at least 1.5x when
+  // exceeded.
   void append(const GaussianHost& batch);
   // Keeps Gaussian i iff keep[i] != 0 (keep.size() == size()); fills holes from the tail, no
   // reallocation; order of survivors is not preserved. Returns the moves made.

@@ -7,4 +7,8 @@ void move_words_cpu(Span<uint32_t> data, int words, Span<const int32_t> src, Spa
   move_words(CpuBackend{}, data, words, src, dst);
 }
 
+void pad_sh_rows_cpu(Span<Eigen::Vector3f> dst, int to, Span<const Eigen::Vector3f> src, int from, int64_t n) {
+  pad_rows(CpuBackend{}, dst, to, src, from, n);
+}
+
 }  // namespace rrg::kernel

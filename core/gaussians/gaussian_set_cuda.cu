@@ -8,4 +8,9 @@ void move_words_cuda(Span<uint32_t> data, int words, Span<const int32_t> src, Sp
   RRG_CUDA_CHECK(cudaStreamSynchronize(nullptr));
 }
 
+void pad_sh_rows_cuda(Span<Eigen::Vector3f> dst, int to, Span<const Eigen::Vector3f> src, int from, int64_t n) {
+  pad_rows(CudaBackend{}, dst, to, src, from, n);
+  RRG_CUDA_CHECK(cudaStreamSynchronize(nullptr));
+}
+
 }  // namespace rrg::kernel

@@ -1,6 +1,9 @@
 #pragma once
-// Per-Gaussian moves of GaussianSet::prune / apply_compaction, templated on the back end.
+// Per-Gaussian moves of GaussianSet::prune / apply_compaction and the SH padding of
+// GaussianSet::append, templated on the back end.
 #include "core/common/span.h"
+
+#include <Eigen/Core>
 
 #include <cstdint>
 
@@ -17,7 +20,20 @@ void move_words(Backend backend, Span<uint32_t> data, int words, Span<const int3
   });
 }
 
+// Coefficient rows of n Gaussians with `from` SH coefficients each (src, [n, from]) written into
+// rows of `to` >= from coefficients (dst, [n, to]), the higher bands zero: a batch of new Gaussians
+// (DC only, say) appended to a set of higher degree.
+template <class Backend, class C>
+void pad_rows(Backend backend, Span<C> dst, int to, Span<const C> src, int from, int64_t n) {
+  parallel_for(backend, n * to, [=] RRG_HD(int64_t i) {
+    const int64_t g = i / to, k = i % to;
+    dst[i] = k < from ? src[g * from + k] : C::Zero();
+  });
+}
+
 void move_words_cpu(Span<uint32_t> data, int words, Span<const int32_t> src, Span<const int32_t> dst);
 void move_words_cuda(Span<uint32_t> data, int words, Span<const int32_t> src, Span<const int32_t> dst);
+void pad_sh_rows_cpu(Span<Eigen::Vector3f> dst, int to, Span<const Eigen::Vector3f> src, int from, int64_t n);
+void pad_sh_rows_cuda(Span<Eigen::Vector3f> dst, int to, Span<const Eigen::Vector3f> src, int from, int64_t n);
 
 }  // namespace rrg::kernel

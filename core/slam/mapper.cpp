@@ -279,12 +279,15 @@ MappingStats GaussianMapper::run(std::shared_ptr<Prepared> prepared, const Mappi
       v.virtual_depth = &virtual_depth;
     }
     const uint64_t fseed = mix(seed ^ mix(uint64_t(f.frame->index)));
-    const GaussianHost nb = densify_base(v, params_.densify, params_.sh_degree, fseed,
+    // New Gaussians start with the DC band only: the batches carry degree 0 and append() zeroes the
+    // higher bands on the device (a degree-3 host batch is 240 bytes a Gaussian, 192 of them zeros).
+    constexpr int kNewShDegree = 0;
+    const GaussianHost nb = densify_base(v, params_.densify, kNewShDegree, fseed,
                                          reflections ? std::span<const ReflectivePlane>(ctx.planes) : std::span<const ReflectivePlane>{});
     append_to(base_, adam_base_, nb);
     st.base_added += int64_t(nb.size());
     if (reflections) {
-      const GaussianHost nr = densify_reflection(v, ctx.planes, params_.densify, params_.sh_degree, mix(fseed));
+      const GaussianHost nr = densify_reflection(v, ctx.planes, params_.densify, kNewShDegree, mix(fseed));
       append_to(refl_, adam_refl_, nr);
       st.reflection_added += int64_t(nr.size());
     }

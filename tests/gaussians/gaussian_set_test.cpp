@@ -169,6 +169,37 @@ TEST(GaussianSet, PruneEverythingAndGrowAgain) {
   EXPECT_EQ(s.to_host().plane_ids, (std::vector<int32_t>{7, 8, 9}));
 }
 
+// A batch of lower SH degree (densification's DC-only Gaussians) lands with its bands and zeros
+// above them, after Gaussians that keep all of theirs; the same on every device.
+TEST(GaussianSet, AppendPadsALowerDegreeBatchOnEveryDevice) {
+  test::expect_device_parity<float>(
+      [](const Device& d) {
+        GaussianSet s(3, d);
+        s.append(tagged(5, 3));
+        GaussianHost dc = tagged(7, 0, 100);
+        s.append(dc);
+        s.append(tagged(2, 1, 200));
+        const GaussianHost h = s.to_host();
+        EXPECT_EQ(h.sh_degree, 3);
+        EXPECT_EQ(h.size(), 14u);
+        const int K = h.sh_coeffs();  // 16
+        std::vector<float> out;
+        for (size_t i = 0; i < h.size(); ++i) {
+          const float id = h.logit_opacities[i];
+          const int kept = i < 5 ? K : (i < 12 ? 1 : 4);  // bands of the batch it came in
+          EXPECT_EQ(h.means[i], Eigen::Vector3f(id, id + 0.5f, -id)) << i;
+          EXPECT_EQ(h.plane_ids[i], int32_t(id)) << i;
+          for (int k = 0; k < K; ++k) {
+            const Eigen::Vector3f want = k < kept ? Eigen::Vector3f(id, float(k), id * k) : Eigen::Vector3f::Zero();
+            EXPECT_EQ(h.sh[i * size_t(K) + size_t(k)], want) << "Gaussian " << i << " coefficient " << k;
+            out.insert(out.end(), {h.sh[i * size_t(K) + size_t(k)].x(), h.sh[i * size_t(K) + size_t(k)].y()});
+          }
+        }
+        return out;
+      },
+      0.0);
+}
+
 TEST(GaussianSet, BadInputsAreNamed) {
   GaussianSet s(1, Device::cpu());
   GaussianHost h = tagged(4, 1);
@@ -179,7 +210,7 @@ TEST(GaussianSet, BadInputsAreNamed) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("sh has 15 entries, expected 16"), std::string::npos) << e.what();
   }
-  EXPECT_THROW(s.append(tagged(2, 3)), std::invalid_argument);  // degree mismatch
+  EXPECT_THROW(s.append(tagged(2, 3)), std::invalid_argument);  // a batch of higher degree than the set
   s.append(tagged(2, 1));
   EXPECT_THROW(s.prune({1}), std::invalid_argument);
   EXPECT_THROW(GaussianSet(4, Device::cpu()), std::invalid_argument);
