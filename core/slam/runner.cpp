@@ -176,6 +176,15 @@ std::vector<NamedPose> read_render_poses(const std::filesystem::path& file) {
   return poses;
 }
 
+SessionFrame to_session_frame(io::Frame&& f) {
+  SessionFrame frame;
+  frame.index = int64_t(f.index);
+  frame.timestamp = f.timestamp;
+  frame.color = std::move(f.color);
+  frame.depth = std::move(f.depth);
+  return frame;
+}
+
 RunResult run_dataset(const RunOptions& o) {
   const auto dataset = io::open_dataset(o.dataset, o.dataset_options);
   SessionConfig config = o.config;
@@ -210,13 +219,10 @@ RunResult run_dataset(const RunOptions& o) {
   OrderedPrefetch<SessionFrame> loaded(
       [&](size_t i) {
         io::Frame f = dataset->load(i);
-        SessionFrame frame;
-        frame.index = int64_t(i);
-        frame.timestamp = f.timestamp;
-        frame.color = std::move(f.color);
-        frame.depth = std::move(f.depth);
+        const std::optional<Eigen::Isometry3d> T_gt = f.T_wc_gt;
+        SessionFrame frame = to_session_frame(std::move(f));
         if (config.semantics == "labels") frame.labels = io::read_synth_labels(dataset->root(), i);
-        if (f.T_wc_gt && (i == 0 || config.gt_poses)) frame.pose = f.T_wc_gt->cast<float>();
+        if (T_gt && (i == 0 || config.gt_poses)) frame.pose = T_gt->cast<float>();
         return frame;
       },
       n, loaders + 2, loaders);

@@ -34,6 +34,9 @@ struct RunOptions {
   std::function<bool()> stop;
 };
 
+// A dataset frame as a session frame: index, timestamp, colour and depth (no labels, no pose).
+SessionFrame to_session_frame(io::Frame&& frame);
+
 // One named pose to render: "name tx ty tz qx qy qz qw", or a TUM line (the name is then the
 // line's index, 6 digits). Throws std::runtime_error naming the file and line.
 struct NamedPose {

@@ -4,6 +4,7 @@
 // strictly.
 #include "core/io/dataset.h"
 #include "core/io/draco_mesh.h"
+#include "core/slam/runner.h"
 #include "core/slam/session.h"
 #include "server/mesh_chunks.h"
 #include "tests/support/test_support.h"
@@ -44,16 +45,13 @@ class MeshChunksSession : public ::testing::Test {
   // patch_only: depth only in a 12x12-pixel window at the centre, so the frame fuses a small region.
   void process(size_t i, bool patch_only = false) {
     io::Frame f = dataset_->load(i);
-    SessionFrame s;
-    s.index = int64_t(i);
-    s.timestamp = f.timestamp;
-    s.color = std::move(f.color);
-    s.depth = std::move(f.depth);
+    const Eigen::Isometry3f T_wc = f.T_wc_gt->cast<float>();
+    SessionFrame s = to_session_frame(std::move(f));
     if (patch_only)
       for (int y = 0; y < s.depth.height(); ++y)
         for (int x = 0; x < s.depth.width(); ++x)
           if (std::abs(x - s.depth.width() / 2) > 6 || std::abs(y - s.depth.height() / 2) > 6) s.depth(x, y) = 0;
-    s.pose = f.T_wc_gt->cast<float>();
+    s.pose = T_wc;
     session_->process(s);
   }
   // key -> (etag, Draco bytes) of every chunk
