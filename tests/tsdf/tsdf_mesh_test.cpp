@@ -88,7 +88,7 @@ TEST(TsdfMesh, BlocksMeshedSeparatelyWeldToTheWholeMesh) {
 // may fuse the neighbouring pixel on one of them (tsdf_fusion_test.cpp allows 0.5 % of the voxels
 // to differ for that reason); the vertices on that voxel's edges then move by a fraction of the
 // pixel's footprint over the voxel's weight: at most 0.1 % of the vertices may differ by more than
-// 0.2 mm (H200, 2026-12-04: 3 of 10k by 0.28 mm), none by more than 1 mm (a tenth of a voxel).
+// 0.2 mm (H200, 2026-12-04: 3 coordinates, up to 0.28 mm), none by more than 1 mm (a tenth of a voxel).
 TEST(TsdfMesh, SameMeshOnEveryDevice) {
   test::report_cuda_parity_status();
   const TriangleMesh cpu = extract_mesh(fused_sphere(Device::cpu()));
