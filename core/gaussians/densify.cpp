@@ -80,23 +80,21 @@ std::array<Eigen::Vector3i, 27> cells_nearest_first() {
 }
 
 // The points of each occupied cell: a run [begin, end) of the cell-sorted order, found through an
-// open-addressing table keyed by cell (keys use 63 bits, so ~0 marks an empty slot).
+// open-addressing table keyed by cell (keys use 63 bits, so ~0 marks an empty slot). `starts`: where
+// each cell's run begins in `sorted`, then sorted.size().
 class CellRuns {
  public:
-  explicit CellRuns(std::span<const std::pair<uint64_t, int32_t>> sorted) {
-    size_t cells = 0;
-    for (size_t k = 0; k < sorted.size(); ++k) cells += k == 0 || sorted[k].first != sorted[k - 1].first;
+  CellRuns(std::span<const std::pair<uint64_t, int32_t>> sorted, std::span<const uint32_t> starts) {
+    const size_t cells = starts.size() - 1;
     size_t size = 16;
     while (size < 2 * cells) size *= 2;
     mask_ = size - 1;
     slots_.assign(size, Slot{});
-    for (size_t k = 0; k < sorted.size();) {
-      size_t e = k + 1;
-      while (e < sorted.size() && sorted[e].first == sorted[k].first) ++e;
-      size_t h = splitmix64(sorted[k].first) & mask_;
+    for (size_t c = 0; c < cells; ++c) {
+      const uint64_t key = sorted[starts[c]].first;
+      size_t h = splitmix64(key) & mask_;
       while (slots_[h].key != kEmpty) h = (h + 1) & mask_;
-      slots_[h] = {sorted[k].first, uint32_t(k), uint32_t(e)};
-      k = e;
+      slots_[h] = {key, starts[c], starts[c + 1]};
     }
   }
   // [begin, end) of the cell's points; an empty range when the cell holds none.
@@ -136,11 +134,11 @@ std::vector<float> knn3_scale(std::span<const Eigen::Vector3f> pts, float cap) {
   std::vector<Eigen::Vector3f> sorted_pts(pts.size());
 #pragma omp parallel for schedule(static)
   for (int64_t k = 0; k < n; ++k) sorted_pts[size_t(k)] = pts[size_t(sorted[size_t(k)].second)];
-  const CellRuns runs(sorted);
   std::vector<uint32_t> cell_starts;  // where each occupied cell's run begins in `sorted`, then n
   for (int64_t k = 0; k < n; ++k)
     if (k == 0 || sorted[size_t(k)].first != sorted[size_t(k) - 1].first) cell_starts.push_back(uint32_t(k));
   cell_starts.push_back(uint32_t(n));
+  const CellRuns runs(sorted, cell_starts);
   static const std::array<Eigen::Vector3i, 27> kCells = cells_nearest_first();
   const float cap2 = cap * cap;
   const int64_t cells = int64_t(cell_starts.size()) - 1;

@@ -280,7 +280,7 @@ MappingStats GaussianMapper::run(std::shared_ptr<Prepared> prepared, const Mappi
     }
     const uint64_t fseed = mix(seed ^ mix(uint64_t(f.frame->index)));
     // New Gaussians start with the DC band only: the batches carry degree 0 and append() zeroes the
-    // higher bands on the device (a degree-3 host batch is 240 bytes a Gaussian, 192 of them zeros).
+    // higher bands on the device (a degree-3 host batch is 240 bytes a Gaussian, 180 of them zeros).
     constexpr int kNewShDegree = 0;
     const GaussianHost nb = densify_base(v, params_.densify, kNewShDegree, fseed,
                                          reflections ? std::span<const ReflectivePlane>(ctx.planes) : std::span<const ReflectivePlane>{});
