@@ -116,6 +116,9 @@ case "${1:-}" in
     step synth_mr320 30 rrg synth --preset mirror_room --frames 300 --noise --out "$data/mr320"
     # the CPU runs' voxels (1 cm, truncation 4 cm), for figures comparable with them
     run_scene run_mr320_1cm "$data/mr320" --ablate-reflections --set tsdf.voxel_size=0.01 --set tsdf.truncation=0.04
+    # office has no reflective surface: reflections on vs off must agree (#8: within 0.3 dB)
+    step synth_of320 30 rrg synth --preset office --frames 300 --noise --out "$data/of320"
+    run_scene run_of320 "$data/of320" --ablate-reflections
     # 4. memory errors
     if command -v compute-sanitizer > /dev/null; then
       step sanitizer_tsdf 60 compute-sanitizer --error-exitcode=1 test_tsdf --gtest_brief=1 \

@@ -156,6 +156,12 @@ void GaussianSet::append(const GaussianHost& batch) {
   size_ = n;
 }
 
+void GaussianSet::remap_plane_ids(std::span<const int32_t> remap) {
+  if (size_ == 0 || remap.empty()) return;
+  const auto table = Buffer<int32_t>::from_host(remap, device_);
+  RRG_DISPATCH(device_, kernel::remap_ids_cpu(plane_ids(), table.span()), kernel::remap_ids_cuda(plane_ids(), table.span()));
+}
+
 Compaction GaussianSet::prune(const std::vector<uint8_t>& keep) {
   if (keep.size() != size_)
     throw std::invalid_argument("GaussianSet::prune: keep mask has " + std::to_string(keep.size()) +

@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace rrg {
@@ -77,6 +78,10 @@ class GaussianSet {
   // reallocation; order of survivors is not preserved. Returns the moves made.
   Compaction prune(const std::vector<uint8_t>& keep);
   void clear() { size_ = 0; }
+  // Relabels the plane ids l through an id -> canonical id table (GlobalPlaneTable::remap_table():
+  // when the plane table merges two instances, the Gaussians of the absorbed one move to the one
+  // that absorbed it). Ids the table does not cover, or maps to 0, stay. On the set's device.
+  void remap_plane_ids(std::span<const int32_t> remap);
 
   // Views over the first size() Gaussians, on device().
   Span<Eigen::Vector3f> means() { return {means_.data(), int64_t(size_)}; }

@@ -11,4 +11,6 @@ void pad_sh_rows_cpu(Span<Eigen::Vector3f> dst, int to, Span<const Eigen::Vector
   pad_rows(CpuBackend{}, dst, to, src, from, n);
 }
 
+void remap_ids_cpu(Span<int32_t> ids, Span<const int32_t> remap) { remap_ids(CpuBackend{}, ids, remap); }
+
 }  // namespace rrg::kernel

@@ -13,4 +13,9 @@ void pad_sh_rows_cuda(Span<Eigen::Vector3f> dst, int to, Span<const Eigen::Vecto
   RRG_CUDA_CHECK(cudaStreamSynchronize(nullptr));
 }
 
+void remap_ids_cuda(Span<int32_t> ids, Span<const int32_t> remap) {
+  remap_ids(CudaBackend{}, ids, remap);
+  RRG_CUDA_CHECK(cudaStreamSynchronize(nullptr));
+}
+
 }  // namespace rrg::kernel

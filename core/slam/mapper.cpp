@@ -69,6 +69,17 @@ void append_to(GaussianSet& set, GaussianAdam& adam, const GaussianHost& batch) 
   adam.grow(set.size());
 }
 
+// Moves Gaussians of planes the table has merged away to the canonical id (remap); returns how
+// many of the set's distinct plane ids moved (0: nothing is written).
+int relabel_planes(GaussianSet& set, std::span<const int32_t> remap) {
+  if (set.size() == 0 || remap.empty()) return 0;
+  int moved = 0;
+  for (const int32_t l : distinct_planes(set))
+    if (size_t(l) < remap.size() && remap[size_t(l)] > 0 && remap[size_t(l)] != l) ++moved;
+  if (moved > 0) set.remap_plane_ids(remap);
+  return moved;
+}
+
 int64_t prune_set(GaussianSet& set, GaussianAdam& adam, const PruneParams& p) {
   const std::vector<uint8_t> keep = prune_mask(set, p);
   const size_t before = set.size();
@@ -251,8 +262,13 @@ MappingStats GaussianMapper::run(std::shared_ptr<Prepared> prepared, const Mappi
     return st;
   }
 
-  // 2. densification on the local frames
+  // 1b. The plane table merges instances (the lower id absorbs the higher), and the raycasts give
+  // I(u) as canonical ids; a reflection Gaussian still carrying an absorbed id l would never again
+  // meet a pixel with I(u) = l in the grouped pass 3: no colour, no gradient, never pruned.
   auto t0 = Clock::now();
+  st.planes_relabelled = relabel_planes(refl_, ctx.remap);
+
+  // 2. densification on the local frames
   const bool reflections = params_.reflections && !ctx.planes.empty();
   RenderOutputs out;
   for (StepFrame& f : frames) {
@@ -338,6 +354,9 @@ MappingStats GaussianMapper::run(std::shared_ptr<Prepared> prepared, const Mappi
 
   publish();
   st.ms_total = ms_since(t_start) + st.ms_raycast;  // pass 1 included, on whichever thread it ran
+  if (st.planes_relabelled > 0)
+    spdlog::debug("mapping step {}: reflection Gaussians of {} merged plane(s) moved to the canonical id",
+                  prepared->step, st.planes_relabelled);
   spdlog::debug("mapping step {}: {} frames, +{} / -{} base ({}), +{} / -{} reflection ({}; pass 3 skipped in {} of {} "
                 "iterations), loss {:.4f}, {:.1f} ms (raycast {:.1f}, densify {:.1f}, optimise {:.1f}, prune {:.1f})",
                 prepared->step, st.frames, st.base_added, st.base_pruned, st.base_size, st.reflection_added,

@@ -101,6 +101,9 @@ struct MappingContext {
   // Pass 1 at a camera (the session serialises it against fusion).
   std::function<RaycastResult(const Intrinsics&, const Eigen::Isometry3f&)> raycast;
   std::vector<ReflectivePlane> planes;  // accepted reflective planes (L_ref) with their equations
+  // Plane id -> canonical id (GlobalPlaneTable::remap_table(), as the raycasts of this step used):
+  // the step first moves reflection Gaussians of a merged-away plane to the id that absorbed it.
+  std::vector<int32_t> remap;
 };
 
 struct MappingStats {
@@ -110,6 +113,7 @@ struct MappingStats {
   int64_t base_size = 0, reflection_size = 0;  // after the step
   double loss = 0;                 // mean total loss over the iterations
   int reflection_skipped = 0;      // iterations whose view shows no reflection Gaussian's plane (pass 3 skipped)
+  int planes_relabelled = 0;       // plane ids of reflection Gaussians moved to the canonical id of a merge
   double ms_raycast = 0, ms_densify = 0, ms_optimise = 0, ms_prune = 0, ms_total = 0;
 };
 

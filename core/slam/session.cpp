@@ -154,6 +154,7 @@ MappingContext Session::Impl::mapping_context() {
   if (config.mapping.reflections) {
     std::lock_guard lock(state_mutex);
     for (const ReflectivePlane& p : reflective) ctx.planes.push_back({p.id, p.plane});
+    ctx.remap = remap;  // as locked_raycast reads it: identification runs on this thread too
   }
   return ctx;
 }

@@ -200,6 +200,26 @@ TEST(GaussianSet, AppendPadsALowerDegreeBatchOnEveryDevice) {
       0.0);
 }
 
+// The plane table merged instances 3 -> 1 and 5 -> 3 -> 1 (remap holds canonical ids); 7 is its own
+// canonical id, 9 lies beyond the table, 2 maps to 0 (unknown): those keep their ids, as does 0.
+TEST(GaussianSet, RemapPlaneIdsFollowsTheTablesMergesOnEveryDevice) {
+  test::expect_device_parity<int32_t>(
+      [](const Device& d) {
+        GaussianHost h = tagged(7, 0);
+        h.plane_ids = {0, 1, 3, 5, 7, 9, 2};
+        GaussianSet s = GaussianSet::from_host(h, d);
+        const std::vector<int32_t> remap = {0, 1, 0, 1, 4, 1, 6, 7};
+        s.remap_plane_ids(remap);
+        const GaussianHost out = s.to_host();
+        EXPECT_EQ(out.plane_ids, (std::vector<int32_t>{0, 1, 1, 1, 7, 9, 2}));
+        EXPECT_EQ(out.means, h.means);  // only the ids move
+        s.remap_plane_ids({});          // an empty table changes nothing
+        EXPECT_EQ(s.to_host().plane_ids, out.plane_ids);
+        return out.plane_ids;
+      },
+      0.0);
+}
+
 TEST(GaussianSet, BadInputsAreNamed) {
   GaussianSet s(1, Device::cpu());
   GaussianHost h = tagged(4, 1);

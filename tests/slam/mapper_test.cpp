@@ -420,5 +420,54 @@ TEST(Mapper, ReflectionPassIsSkippedOnlyWhereItDrawsNothing) {
   EXPECT_LT(skipped, iterations);
 }
 
+// The plane table merges instances between steps (the lower id absorbs the higher) and the raycasts
+// then show the canonical id: the step moves the reflection Gaussians of the absorbed id to it, or
+// the grouped pass 3 would never draw them again (no colour, no gradient, never pruned).
+TEST(Mapper, ReflectionGaussiansFollowAPlaneMerge) {
+  test::MapperSceneParams sp;
+  sp.preset = "mirror_room";
+  sp.width = 48;
+  sp.height = 36;
+  sp.frames = 12;
+  const test::MapperScene s = test::make_mapper_scene(sp);
+  ASSERT_EQ(s.planes.size(), 1u);
+  const int32_t old_id = s.planes[0].id;
+  ASSERT_GT(old_id, 1);
+  const int32_t new_id = old_id - 1;  // the instance that absorbs the mirror's (any lower id)
+  MapperParams p = short_steps();
+  GaussianMapper m(p, s.K, Device::cpu());
+  for (size_t i = 0; i < 6; ++i) m.add_frame(s.frame(i), i % 3 == 0);
+  const MappingStats before = m.step(s.context());
+  EXPECT_EQ(before.planes_relabelled, 0);
+  ASSERT_EQ(m.snapshot()->reflection_planes, std::vector<int32_t>{old_id});
+
+  MappingContext merged = s.context();
+  auto raycast = merged.raycast;
+  merged.raycast = [raycast, old_id, new_id](const Intrinsics& K, const Eigen::Isometry3f& T) {
+    RaycastResult r = raycast(K, T);
+    Image<int32_t> I = r.plane_ids.to_host();
+    for (int32_t& l : I.pixels()) l = l == old_id ? new_id : l;
+    r.plane_ids = DeviceImage<int32_t>::from_host(I, Device::cpu());
+    return r;
+  };
+  merged.planes[0].id = new_id;
+  merged.remap.resize(size_t(old_id) + 1);
+  for (size_t l = 0; l < merged.remap.size(); ++l) merged.remap[l] = int32_t(l);
+  merged.remap[size_t(old_id)] = new_id;
+  for (size_t i = 6; i < 12; ++i) m.add_frame(s.frame(i), i % 3 == 0);
+  const MappingStats after = m.step(merged);
+  EXPECT_EQ(after.planes_relabelled, 1);
+  const auto snap = m.snapshot();
+  ASSERT_GT(snap->reflection.size(), 0u);
+  EXPECT_EQ(snap->reflection_planes, std::vector<int32_t>{new_id});  // none left behind on the absorbed id
+  bool drawn = false;
+  for (const Eigen::Isometry3f& T : s.poses) {
+    const RaycastResult rc = merged.raycast(s.K, T);
+    const ColorImage C_r = m.render_reflection({s.K, T}, rc.plane_ids);
+    for (const Color& c : C_r.pixels()) drawn = drawn || c != Color::Zero();
+  }
+  EXPECT_TRUE(drawn);  // the merged plane's pixels show the reflection Gaussians
+}
+
 }  // namespace
 }  // namespace rrg
