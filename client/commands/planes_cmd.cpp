@@ -113,6 +113,7 @@ struct EvalOptions {
   std::string dataset, semantics = "labels", prompts, remote, device = "cpu";
   int period = 10, max_frames = 0;
   float voxel = 0.02f, delta_v = 0.01f, delta_area = 0.05f, border_voxels = IdentificationParams{}.variance_border_voxels;
+  int border_pixels = IdentificationParams{}.variance_border_pixels;
   bool no_fuse = false, json = false, no_color_edges = false;
 };
 
@@ -130,6 +131,7 @@ void run_eval(const EvalOptions& o) {
   e.params.variance_threshold = o.delta_v;
   e.params.area_threshold = o.delta_area;
   e.params.variance_border_voxels = o.border_voxels;
+  e.params.variance_border_pixels = o.border_pixels;
   e.params.variance_skip_color_edges = !o.no_color_edges;
   spdlog::info("planes eval: {} semantics {} period {} voxel {} m on {}, δ_v {} δ_area {}", o.dataset, o.semantics,
                o.period, o.voxel, e.device.to_string(), o.delta_v, o.delta_area);
@@ -239,6 +241,9 @@ void register_planes_command(CLI::App& app) {
   e->add_option("--border-voxels", ev->border_voxels,
                 "leave pixels this many TSDF voxels from a plane's border out of the variance check (0 = none)")
       ->capture_default_str();
+  e->add_option("--border-pixels", ev->border_pixels, "... plus this many pixels (the fusion's nearest-pixel footprint)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 16));
   e->add_flag("--no-color-edges", ev->no_color_edges,
               "keep pixels near colour edges of the input in the variance check")
       ->capture_default_str();

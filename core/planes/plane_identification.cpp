@@ -13,13 +13,14 @@ namespace rrg {
 
 namespace {
 
-// Pixels at least `border_m` (on the image at their depth) inside their region of `map`: every
-// pixel of the square of radius r = ceil(border_m · fx / z) around them carries the same non-zero
+// Pixels at least `border_m` (on the image at their depth) plus `border_px` pixels inside their
+// region of `map`: every pixel of the square of radius r = ceil(border_m · fx / z) + border_px
+// around them carries the same non-zero
 // value. O(pixels): a two-pass chessboard distance transform gives each pixel the distance k to the
 // nearest pixel of its region that touches another value (8-neighbourhood) or the image border;
 // the square of radius r is then uniform exactly when k >= r.
 template <class T>
-MaskImage interior(const Image<T>& map, const DepthImage& depth, const Intrinsics& K, float border_m) {
+MaskImage interior(const Image<T>& map, const DepthImage& depth, const Intrinsics& K, float border_m, int border_px) {
   const int w = map.width(), h = map.height();
   Image<int32_t> k(w, h, 0);
   for (int y = 0; y < h; ++y)
@@ -46,7 +47,7 @@ MaskImage interior(const Image<T>& map, const DepthImage& depth, const Intrinsic
     for (int x = 0; x < w; ++x) {
       const float z = depth(x, y);
       if (map(x, y) == T(0) || !(z > 0)) continue;
-      const int r = border_m > 0 ? std::min(16, int(std::ceil(border_m * K.fx / z))) : 0;
+      const int r = std::min(16, (border_m > 0 ? int(std::ceil(border_m * K.fx / z)) : 0) + border_px);
       inner(x, y) = k(x, y) >= r ? 1 : 0;
     }
   return inner;
@@ -85,6 +86,8 @@ void IdentificationParams::validate() const {
     throw std::invalid_argument("IdentificationParams: area_threshold must be in [0, 1)");
   if (!(variance_border_voxels >= 0 && variance_border_voxels <= 64))
     throw std::invalid_argument("IdentificationParams: variance_border_voxels must be in [0, 64]");
+  if (!(variance_border_pixels >= 0 && variance_border_pixels <= 16))
+    throw std::invalid_argument("IdentificationParams: variance_border_pixels must be in [0, 16]");
   if (!(min_mask_overlap >= 0 && min_mask_overlap <= 1))
     throw std::invalid_argument("IdentificationParams: min_mask_overlap must be in [0, 1]");
 }
@@ -133,14 +136,15 @@ IdentificationResult PlaneIdentifier::identify(const IdentificationFrame& frame,
   // Interiors: of the planes, and of the reflective masks (a colour edge at a mask's border
   // aliases into C_var the same way a plane border does).
   const float border_m = params_.variance_border_voxels * std::max(frame.voxel_size, 0.0f);
+  const int border_px = params_.variance_border_pixels;
   const MaskImage plane_inner =
       params_.variance_skip_color_edges
           ? interior(without_color_edges(out.global_map, *frame.color, 2.0f * std::sqrt(params_.variance_threshold)), depth,
-                     frame.K, border_m)
-          : interior(out.global_map, depth, frame.K, border_m);
+                     frame.K, border_m, border_px)
+          : interior(out.global_map, depth, frame.K, border_m, border_px);
   std::vector<MaskImage> mask_inner(masks.size());
   for (size_t m = 0; m < masks.size(); ++m)
-    if (masks[m].reflective) mask_inner[m] = interior(masks[m].mask, depth, frame.K, border_m);
+    if (masks[m].reflective) mask_inner[m] = interior(masks[m].mask, depth, frame.K, border_m, border_px);
   std::map<int, Stats> stats;
   std::vector<int64_t> mask_pixels(masks.size(), 0);
   for (size_t i = 0; i < out.global_map.size(); ++i) {

@@ -38,6 +38,14 @@ struct IdentificationParams {
   // across a border, so a thin matte plane beside a mirror (its frame) would otherwise inherit the
   // mirror's variance, and a colour edge (a whiteboard's rim on a wall) aliases into variance.
   float variance_border_voxels = 2.0f;
+  // Plus this many pixels: fusion gives a voxel the colour of the pixel its centre projects to in
+  // each frame (nearest pixel: up to half a pixel off), the tracked poses are off by up to about a
+  // pixel footprint (ATE 0.3-0.5 cm, a pixel spans ~1 cm at 2.5 m at 320x240), and this frame's
+  // border is itself quantised to half a pixel: about two pixels (of the same camera, at similar
+  // range) on which a voxel near a border may take the other side's colour. The voxel term alone
+  // is 1-2 pixels at 0.5 cm voxels and 320x240, and a mirror frame's bars (8 cm) passed the
+  // variance check in 9 of 10 accepted planes; with 1 extra pixel 3 of 4 (docs/planes.md).
+  int variance_border_pixels = 2;
   // Colour edges are borders too: where the input colour C_k steps by more than 2√δ_v in intensity
   // between neighbouring pixels of one plane, the pixels within the same radius are left out. A
   // voxel whose observations fall on either side of such a step (pixel quantisation, pose error,

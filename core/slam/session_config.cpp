@@ -203,6 +203,8 @@ std::vector<ConfigField> config_fields(SessionConfig& c) {
   t.f("planes.area_threshold", c.planes.area_threshold, "δ_area");
   t.f("planes.variance_border_voxels", c.planes.variance_border_voxels,
       "pixels this many TSDF voxels from a plane's border are left out of the variance check");
+  t.i("planes.variance_border_pixels", c.planes.variance_border_pixels,
+      "... plus this many pixels (the fusion's nearest-pixel footprint)");
   t.b("planes.variance_skip_color_edges", c.planes.variance_skip_color_edges,
       "pixels as near to a colour edge of the input (step > 2 sqrt(delta_v)) are left out too");
   t.i("planes.vote.windows", c.planes.vote.windows, "vote history, windows");

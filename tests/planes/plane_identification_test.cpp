@@ -180,11 +180,11 @@ TEST(PlaneIdentification, InputErrors) {
 namespace rrg {
 namespace {
 
-// C_var bleeds across a plane border through the raycast's trilinear interpolation: here the wall
-// varies everywhere and the floor only in the 4 pixel rows next to the wall (7% of its pixels, above
-// δ_area). Measured on interior pixels only (2 voxels of 2 cm = 3 px at 4 m), the floor is not
+// C_var bleeds across a plane border through the raycast's trilinear interpolation and the
+// fusion's nearest-pixel association: here the wall varies everywhere and the floor only in the
+// `rows` pixel rows next to the wall. Measured on interior pixels only, the floor is not
 // reflective; with the erosion off it is (the failure the erosion exists for).
-TEST(PlaneIdentification, VarianceBleedingAcrossAPlaneBorderIsIgnored) {
+PlaneVerdict floor_next_to_a_varying_wall(int rows, float voxel_size, float border_voxels, int border_pixels) {
   Scene s = make_scene();
   std::vector<int> first_floor_row(320, -1);
   for (int u = 0; u < 320; ++u)
@@ -192,22 +192,37 @@ TEST(PlaneIdentification, VarianceBleedingAcrossAPlaneBorderIsIgnored) {
       if (s.labels(u, v) == 1) first_floor_row[u] = v;
   for (int v = 0; v < 240; ++v)
     for (int u = 0; u < 320; ++u)
-      s.cvar(u, v) = s.labels(u, v) == 2 || v < first_floor_row[u] + 4 ? 0.05f : 0.0f;
-  auto floor_fraction = [&](float border_voxels) {
-    IdentificationParams p;
-    p.variance_border_voxels = border_voxels;
-    PlaneIdentifier id(p, make_no_semantics());
-    const IdentificationResult r =
-        id.identify({&s.depth, &s.color, &s.labels, s.K, Eigen::Isometry3f::Identity(), 0, 0.02f}, s.cvar);
-    EXPECT_TRUE(verdict_for_label(r, s, 2).reflective_now);  // the wall varies everywhere
-    EXPECT_GT(verdict_for_label(r, s, 2).variance_fraction, 0.95f);
-    return verdict_for_label(r, s, 1);
-  };
-  const PlaneVerdict eroded = floor_fraction(2.0f), raw = floor_fraction(0.0f);
+      s.cvar(u, v) = s.labels(u, v) == 2 || v < first_floor_row[u] + rows ? 0.05f : 0.0f;
+  IdentificationParams p;
+  p.variance_border_voxels = border_voxels;
+  p.variance_border_pixels = border_pixels;
+  PlaneIdentifier id(p, make_no_semantics());
+  const IdentificationResult r =
+      id.identify({&s.depth, &s.color, &s.labels, s.K, Eigen::Isometry3f::Identity(), 0, voxel_size}, s.cvar);
+  EXPECT_TRUE(verdict_for_label(r, s, 2).reflective_now);  // the wall varies everywhere
+  EXPECT_GT(verdict_for_label(r, s, 2).variance_fraction, 0.95f);
+  return verdict_for_label(r, s, 1);
+}
+
+// 4 rows (7 % of the floor, above δ_area) against 2 voxels of 2 cm (3 px at 4 m).
+TEST(PlaneIdentification, VarianceBleedingAcrossAPlaneBorderIsIgnored) {
+  const PlaneVerdict eroded = floor_next_to_a_varying_wall(4, 0.02f, 2.0f, 0),
+                     raw = floor_next_to_a_varying_wall(4, 0.02f, 0.0f, 0);
   EXPECT_GT(raw.variance_fraction, 0.05f);
   EXPECT_TRUE(raw.reflective_now);
   EXPECT_LT(eroded.variance_fraction, 0.03f);
   EXPECT_FALSE(eroded.reflective_now);
+}
+
+// With fine voxels the voxel term shrinks (2 voxels of 5 mm: 1 px at 4 m here) but the fusion's
+// pixel-scale bleeding does not: of 3 bleeding rows, 2 stay in the check on the voxel term alone
+// (3.5 % of the floor) and none with the default two extra pixels.
+TEST(PlaneIdentification, BorderErosionKeepsAPixelMarginAtFineVoxels) {
+  const PlaneVerdict voxels_only = floor_next_to_a_varying_wall(3, 0.005f, 2.0f, 0),
+                     with_pixels = floor_next_to_a_varying_wall(3, 0.005f, 2.0f, IdentificationParams{}.variance_border_pixels);
+  EXPECT_EQ(IdentificationParams{}.variance_border_pixels, 2);
+  EXPECT_GT(voxels_only.variance_fraction, 0.03f);
+  EXPECT_LT(with_pixels.variance_fraction, 0.005f);
 }
 
 // Texture aliases into C_var at colour edges: here the wall carries dark 2-pixel stripes every 16
