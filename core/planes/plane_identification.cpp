@@ -15,10 +15,9 @@ namespace {
 
 // Pixels at least `border_m` (on the image at their depth) plus `border_px` pixels inside their
 // region of `map`: every pixel of the square of radius r = ceil(border_m · fx / z) + border_px
-// around them carries the same non-zero
-// value. O(pixels): a two-pass chessboard distance transform gives each pixel the distance k to the
-// nearest pixel of its region that touches another value (8-neighbourhood) or the image border;
-// the square of radius r is then uniform exactly when k >= r.
+// around them carries the same non-zero value. O(pixels): a two-pass chessboard distance transform
+// gives each pixel the distance k to the nearest pixel of its region that touches another value
+// (8-neighbourhood) or the image border; the square of radius r is then uniform exactly when k >= r.
 template <class T>
 MaskImage interior(const Image<T>& map, const DepthImage& depth, const Intrinsics& K, float border_m, int border_px) {
   const int w = map.width(), h = map.height();
