@@ -424,12 +424,7 @@ TEST(Mapper, ReflectionPassIsSkippedOnlyWhereItDrawsNothing) {
 // then show the canonical id: the step moves the reflection Gaussians of the absorbed id to it, or
 // the grouped pass 3 would never draw them again (no colour, no gradient, never pruned).
 TEST(Mapper, ReflectionGaussiansFollowAPlaneMerge) {
-  test::MapperSceneParams sp;
-  sp.preset = "mirror_room";
-  sp.width = 48;
-  sp.height = 36;
-  sp.frames = 12;
-  const test::MapperScene s = test::make_mapper_scene(sp);
+  const test::MapperScene s = small_scene();  // mirror_room, the mirror as the reflective plane
   ASSERT_EQ(s.planes.size(), 1u);
   const int32_t old_id = s.planes[0].id;
   ASSERT_GT(old_id, 1);
