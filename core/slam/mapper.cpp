@@ -69,6 +69,14 @@ void append_to(GaussianSet& set, GaussianAdam& adam, const GaussianHost& batch) 
   adam.grow(set.size());
 }
 
+// Ids the table has merged into another instance (remap[l] is a positive id other than l). Merges
+// are permanent, so the count only grows, and it grows exactly when a merge happened.
+size_t absorbed_ids(std::span<const int32_t> remap) {
+  size_t n = 0;
+  for (size_t l = 0; l < remap.size(); ++l) n += remap[l] > 0 && remap[l] != int32_t(l);
+  return n;
+}
+
 // Moves Gaussians of planes the table has merged away to the canonical id (remap); returns how
 // many of the set's distinct plane ids moved (0: nothing is written).
 int relabel_planes(GaussianSet& set, std::span<const int32_t> remap) {
@@ -266,7 +274,12 @@ MappingStats GaussianMapper::run(std::shared_ptr<Prepared> prepared, const Mappi
   // I(u) as canonical ids; a reflection Gaussian still carrying an absorbed id l would never again
   // meet a pixel with I(u) = l in the grouped pass 3: no colour, no gradient, never pruned.
   auto t0 = Clock::now();
-  st.planes_relabelled = relabel_planes(refl_, ctx.remap);
+  // Only after a new merge: Gaussians densified since the last one carry canonical ids already, and
+  // listing the set's planes copies and sorts every id.
+  if (const size_t absorbed = absorbed_ids(ctx.remap); absorbed != remap_absorbed_) {
+    st.planes_relabelled = relabel_planes(refl_, ctx.remap);
+    remap_absorbed_ = absorbed;
+  }
 
   // 2. densification on the local frames
   const bool reflections = params_.reflections && !ctx.planes.empty();
@@ -426,6 +439,7 @@ void GaussianMapper::load(const GaussianHost& base, const GaussianHost& reflecti
   adam_refl_ = GaussianAdam(params_.adam_reflection, reflection.sh_degree, device_);
   adam_base_.reset(base_.size());
   adam_refl_.reset(refl_.size());
+  remap_absorbed_ = 0;  // the loaded ids may predate any merge the next step's table shows
   publish();
 }
 

@@ -182,6 +182,7 @@ class GaussianMapper {
   Renderer renderer_;
   LossScratch loss_scratch_;
   uint64_t steps_ = 0;           // steps prepared (guarded by frames_mutex_)
+  size_t remap_absorbed_ = 0;    // merged-away ids in the remap refl_'s plane ids last went through
 
   mutable std::mutex frames_mutex_;
   std::deque<std::shared_ptr<const StoredFrame>> recent_;
