@@ -325,79 +325,117 @@ GaussianHost densify_base(const DensifyView& v, const DensifyParams& p, int sh_d
   return init_gaussians(pts, nrm, col, ids, opacities, p, p.base_min_init_scale, p.max_init_scale, sh_degree);
 }
 
-GaussianHost densify_reflection(const DensifyView& v, std::span<const ReflectivePlane> planes, const DensifyParams& p,
-                                int sh_degree, uint64_t seed) {
-  p.validate();
-  check_image(v.C_gt, v.K, "C_gt");
-  check_image(v.C, v.K, "C");
-  check_image(v.C_b, v.K, "C_b");
-  check_image(v.W_r, v.K, "W_r");
-  check_image(v.R, v.K, "R");
-  if (p.reflection_variance_gate) check_image(v.C_var, v.K, "C_var");
-  check_image(v.I, v.K, "I");
-  std::unordered_map<int32_t, Eigen::Vector4f> by_id;
-  for (const ReflectivePlane& pl : planes) {
-    const float len = pl.plane.head<3>().norm();
-    if (!(len > 0)) throw std::invalid_argument("densify_reflection: plane " + std::to_string(pl.id) + " has a zero normal");
-    by_id[pl.id] = pl.plane / len;
-  }
-  // One of the S samples along a ray: the sample opacity (together as opaque as one new Gaussian);
-  // a Gaussian at the mirrored surface: the base's initial opacity.
-  const float sample_alpha = p.reflection_sample_alpha();
-  const Eigen::Vector3f o = v.T_wc.translation();
-  const Eigen::Matrix3f R_wc = v.T_wc.linear();
-  const int S = p.reflection_samples;
-  const bool mirrored = p.reflection_mirrored_depth && v.virtual_depth != nullptr;
-  if (mirrored) check_image(v.virtual_depth, v.K, "virtual_depth");
+namespace {
 
-  // What one pixel makes: nothing, one Gaussian at the mirrored surface X, or S samples along the
-  // ray past the ray–plane intersection `hit`. `passed` (when given) counts the pixels left after
-  // each test, in order (the debug log shows where candidates are lost).
-  struct Sample {
-    int count = 0;  // Gaussians: 0, 1 (at X) or S
-    bool at_mirrored = false;
-    int32_t id = 0;
-    Eigen::Vector3f n, dir, hit, X;
-    Color c;
-  };
-  using Passed = std::array<int64_t, 7>;  // on plane, R = 1, wrong, varying, uncovered, sampled, at mirrored
-  const auto sample = [&](int x, int y, Passed* passed) {
-    Sample s;
-    const int32_t id = (*v.I)(x, y);
-    const auto it = id > 0 ? by_id.find(id) : by_id.end();
-    if (it == by_id.end()) return s;
+using ReflectionPassed = std::array<int64_t, 7>;  // on plane, R = 1, wrong, varying, uncovered, sampled, at virtual depth
+
+// The per-pixel tests of reflection densification, in order (DensifyParams): the pixel's plane (its
+// unit equation) when (x, y) passes them all, else null. `passed` (when given) counts the pixels
+// left after each test (the debug log shows where candidates are lost).
+class ReflectionTests {
+ public:
+  ReflectionTests(const DensifyView& v, std::span<const ReflectivePlane> planes, const DensifyParams& p, uint64_t seed)
+      : v_(v), p_(p), seed_(seed) {
+    p.validate();
+    check_image(v.C_gt, v.K, "C_gt");
+    check_image(v.C, v.K, "C");
+    check_image(v.C_b, v.K, "C_b");
+    check_image(v.W_r, v.K, "W_r");
+    check_image(v.R, v.K, "R");
+    if (p.reflection_variance_gate) check_image(v.C_var, v.K, "C_var");
+    check_image(v.I, v.K, "I");
+    for (const ReflectivePlane& pl : planes) {
+      const float len = pl.plane.head<3>().norm();
+      if (!(len > 0)) throw std::invalid_argument("densify_reflection: plane " + std::to_string(pl.id) + " has a zero normal");
+      by_id_[pl.id] = pl.plane / len;
+    }
+  }
+
+  const Eigen::Vector4f* operator()(int x, int y, ReflectionPassed* passed) const {
+    const int32_t id = (*v_.I)(x, y);
+    const auto it = id > 0 ? by_id_.find(id) : by_id_.end();
+    if (it == by_id_.end()) return nullptr;
     const auto pass = [&](int stage) {
       if (passed) ++(*passed)[size_t(stage)];
     };
     pass(0);
-    if ((*v.R)(x, y) == 0) return s;
+    if ((*v_.R)(x, y) == 0) return nullptr;
     pass(1);
-    if (!(color_error((*v.C_gt)(x, y), (*v.C)(x, y)) > p.reflection_error)) return s;
+    if (!(color_error((*v_.C_gt)(x, y), (*v_.C)(x, y)) > p_.reflection_error)) return nullptr;
     pass(2);
-    if (p.reflection_variance_gate && !((*v.C_var)(x, y) > p.variance)) return s;
+    if (p_.reflection_variance_gate && !((*v_.C_var)(x, y) > p_.variance)) return nullptr;
     pass(3);
-    if (!((*v.W_r)(x, y) < p.reflection_weight)) return s;
+    if (!((*v_.W_r)(x, y) < p_.reflection_weight)) return nullptr;
     pass(4);
-    if (!(pixel_uniform(seed, int64_t(y) * v.K.width + x) < p.sample_ratio)) return s;
+    if (!(pixel_uniform(seed_, int64_t(y) * v_.K.width + x) < p_.sample_ratio)) return nullptr;
     pass(5);
+    return &it->second;
+  }
+
+ private:
+  const DensifyView& v_;
+  const DensifyParams& p_;
+  uint64_t seed_;
+  std::unordered_map<int32_t, Eigen::Vector4f> by_id_;
+};
+
+}  // namespace
+
+MaskImage reflection_candidates(const DensifyView& v, std::span<const ReflectivePlane> planes, const DensifyParams& p,
+                                uint64_t seed) {
+  const ReflectionTests tests(v, planes, p, seed);
+  MaskImage out(v.K.width, v.K.height, uint8_t(0));
+#pragma omp parallel for schedule(static)
+  for (int y = 0; y < v.K.height; ++y)
+    for (int x = 0; x < v.K.width; ++x) out(x, y) = tests(x, y, nullptr) != nullptr;
+  return out;
+}
+
+GaussianHost densify_reflection(const DensifyView& v, std::span<const ReflectivePlane> planes, const DensifyParams& p,
+                                int sh_degree, uint64_t seed) {
+  const ReflectionTests tests(v, planes, p, seed);
+  // One of the S samples along a ray: the sample opacity (together as opaque as one new Gaussian);
+  // a Gaussian at the virtual surface (mirrored or plane sweep): the base's initial opacity.
+  const float sample_alpha = p.reflection_sample_alpha();
+  const Eigen::Vector3f o = v.T_wc.translation();
+  const Eigen::Matrix3f R_wc = v.T_wc.linear();
+  const int S = p.reflection_samples;
+  const bool virtual_depth = (p.reflection_mirrored_depth || p.reflection_stereo_depth) && v.virtual_depth != nullptr;
+  if (virtual_depth) check_image(v.virtual_depth, v.K, "virtual_depth");
+
+  // What one pixel makes: nothing, one Gaussian at the virtual surface X, or S samples along the
+  // ray past the ray–plane intersection `hit`.
+  struct Sample {
+    int count = 0;  // Gaussians: 0, 1 (at X) or S
+    bool at_virtual = false;
+    int32_t id = 0;
+    Eigen::Vector3f n, dir, hit, X;
+    Color c;
+  };
+  using Passed = ReflectionPassed;
+  const auto sample = [&](int x, int y, Passed* passed) {
+    Sample s;
+    const Eigen::Vector4f* plane = tests(x, y, passed);
+    if (!plane) return s;
+    const int32_t id = (*v.I)(x, y);
     s.dir = (R_wc * v.K.unproject(float(x), float(y), 1.0f)).normalized();
-    s.n = it->second.head<3>();
+    s.n = plane->head<3>();
     const float denom = s.n.dot(s.dir);
     if (std::abs(denom) < 1e-6f) return s;
-    const float t = -(s.n.dot(o) + it->second.w()) / denom;
+    const float t = -(s.n.dot(o) + plane->w()) / denom;
     if (!(t > 0)) return s;
     s.id = id;
     s.hit = o + t * s.dir;
     s.c = p.reflection_residual_color ? Color(((*v.C_gt)(x, y) - (*v.C_b)(x, y)).cwiseMax(0.0f)) : Color((*v.C_gt)(x, y));
-    if (mirrored) {
-      // One Gaussian at the mirrored surface when it lies behind the plane (the camera's side of
+    if (virtual_depth) {
+      // One Gaussian at the virtual surface when it lies behind the plane (the camera's side of
       // the plane has the opposite sign).
       const float z = (*v.virtual_depth)(x, y);
       s.X = v.T_wc * v.K.unproject(float(x), float(y), z);
-      const float side_cam = s.n.dot(o) + it->second.w(), side_X = s.n.dot(s.X) + it->second.w();
+      const float side_cam = s.n.dot(o) + plane->w(), side_X = s.n.dot(s.X) + plane->w();
       if (z > 0 && side_cam * side_X < 0) {
-        pass(6);
-        s.at_mirrored = true;
+        if (passed) ++(*passed)[6];
+        s.at_virtual = true;
         s.count = 1;
         return s;
       }
@@ -417,7 +455,7 @@ GaussianHost densify_reflection(const DensifyView& v, std::span<const Reflective
     const Sample s = sample(x, y, nullptr);
     for (int j = 0; j < s.count; ++j) {
       const size_t k = size_t(k0 + j);
-      if (s.at_mirrored) {
+      if (s.at_virtual) {
         pts[k] = s.X, opacities[k] = p.init_opacity;
       } else {
         const float d = S == 1 ? p.reflection_near
@@ -431,7 +469,7 @@ GaussianHost densify_reflection(const DensifyView& v, std::span<const Reflective
   for (const Passed& r : passed_by_row)
     for (size_t i = 0; i < passed.size(); ++i) passed[i] += r[i];
   spdlog::debug("densify_reflection: {} reflective plane(s); pixels on them {}, with R = 1 {}, error > {} {}, "
-                "C_var > {} {}, W_r < {} {}, sampled {} ({} at the mirrored surface)",
+                "C_var > {} {}, W_r < {} {}, sampled {} ({} at a virtual depth)",
                 planes.size(), passed[0], passed[1], p.reflection_error, passed[2], p.variance, passed[3],
                 p.reflection_weight, passed[4], passed[5], passed[6]);
   return init_gaussians(pts, nrm, col, ids, opacities, p, p.reflection_min_init_scale, p.reflection_max_init_scale,

@@ -65,6 +65,10 @@ struct DensifyParams {
   // Reflection positions: false = the paper's samples along the ray 2–8 m past the plane; true =
   // one Gaussian at the mirrored surface (DensifyView::virtual_depth) where it is known.
   bool reflection_mirrored_depth = false;
+  // Reflection positions from a plane sweep over the step's other frames (core/slam/reflection_stereo.h):
+  // one Gaussian at the most photo-consistent virtual depth (DensifyView::virtual_depth, where the
+  // mirrored surface is not known), the paper's samples where no other view sees the pixel's ray.
+  bool reflection_stereo_depth = false;
   // The paper's per-pixel C_var > δ_v test for reflection candidates. Off by default: the plane
   // already passed the variance vote (δ_area) to enter L_ref and R marks its reflective region,
   // while a mirror that reflects a uniform surface has no temporal variance there. With the gate,
@@ -89,7 +93,9 @@ struct DensifyView {
   const MaskImage* R = nullptr;         // reflection mask
   const Image<float>* C_var = nullptr;  // TSDF colour variance
   const Image<int32_t>* I = nullptr;    // plane ids
-  const Image<float>* virtual_depth = nullptr;  // optional: depth of the mirrored surface (mirror_depth.h)
+  // optional: depth of the virtual point behind the plane (the mirrored surface, mirror_depth.h, or
+  // the plane sweep, reflection_stereo.h); 0 where unknown
+  const Image<float>* virtual_depth = nullptr;
 };
 
 // With `reflective` planes given (and params.base_leaves_reflections), the pixels that the
@@ -99,6 +105,10 @@ GaussianHost densify_base(const DensifyView& view, const DensifyParams& params, 
                           std::span<const ReflectivePlane> reflective = {});
 GaussianHost densify_reflection(const DensifyView& view, std::span<const ReflectivePlane> planes,
                                 const DensifyParams& params, int sh_degree, uint64_t seed);
+// The pixels densify_reflection() samples with the same arguments (every test but the placement):
+// where a virtual depth is worth computing (view.virtual_depth is not read).
+MaskImage reflection_candidates(const DensifyView& view, std::span<const ReflectivePlane> planes,
+                                const DensifyParams& params, uint64_t seed);
 
 // The shared initialisation: points (world), unit normals along which to flatten, colours, plane ids
 // and opacities in (0, 1), one per point.

@@ -1,5 +1,6 @@
 #include "core/slam/mapper.h"
 #include "core/slam/mirror_depth.h"
+#include "core/slam/reflection_stereo.h"
 
 #include <spdlog/spdlog.h>
 
@@ -140,6 +141,7 @@ struct GaussianMapper::StepFrame {
   RaycastInputs rc;
   Image<float> C_var;  // host, for reflection densification
   Image<uint8_t> R;
+  Image<int32_t> I_host;  // plane ids, with the plane sweep only (the other views of a local frame)
   bool shows_reflection = true;  // some pixel's I(u) is the plane of a reflection Gaussian
 };
 
@@ -283,6 +285,8 @@ MappingStats GaussianMapper::run(std::shared_ptr<Prepared> prepared, const Mappi
 
   // 2. densification on the local frames
   const bool reflections = params_.reflections && !ctx.planes.empty();
+  if (reflections && params_.densify.reflection_stereo_depth)
+    for (StepFrame& f : frames) f.I_host = f.rc.I.to_host();
   RenderOutputs out;
   for (StepFrame& f : frames) {
     if (!f.local) continue;
@@ -302,12 +306,31 @@ MappingStats GaussianMapper::run(std::shared_ptr<Prepared> prepared, const Mappi
     v.R = &f.R;
     v.C_var = &f.C_var;
     v.I = &I;
+    const uint64_t fseed = mix(seed ^ mix(uint64_t(f.frame->index)));
+    const uint64_t rseed = mix(fseed);  // densify_reflection's
     Image<float> virtual_depth;
     if (reflections && params_.densify.reflection_mirrored_depth) {
       virtual_depth = mirrored_depth(ctx.raycast, K_, f.frame->T_wc, I, ctx.planes);
       v.virtual_depth = &virtual_depth;
     }
-    const uint64_t fseed = mix(seed ^ mix(uint64_t(f.frame->index)));
+    if (reflections && params_.densify.reflection_stereo_depth) {
+      // the plane sweep where the mirrored surface is not known, over the pixels that will be sampled
+      MaskImage want = reflection_candidates(v, ctx.planes, params_.densify, rseed);
+      if (!virtual_depth.empty())
+        for (size_t i = 0; i < want.size(); ++i) want[i] = want[i] && !(virtual_depth[i] > 0);
+      std::vector<StereoView> others;
+      for (const StepFrame& g : frames)
+        if (&g != &f) others.push_back({g.frame->T_wc, &g.C_gt_host, &g.I_host});
+      const Image<float> swept = reflection_stereo_depth(K_, f.frame->T_wc, f.C_gt_host, I, &want, ctx.planes, others,
+                                                         params_.reflection_stereo);
+      if (virtual_depth.empty()) {
+        virtual_depth = swept;
+      } else {
+        for (size_t i = 0; i < swept.size(); ++i)
+          if (!(virtual_depth[i] > 0)) virtual_depth[i] = swept[i];
+      }
+      v.virtual_depth = &virtual_depth;
+    }
     // New Gaussians start with the DC band only: the batches carry degree 0 and append() zeroes the
     // higher bands on the device (a degree-3 host batch is 240 bytes a Gaussian, 180 of them zeros).
     constexpr int kNewShDegree = 0;
@@ -316,7 +339,7 @@ MappingStats GaussianMapper::run(std::shared_ptr<Prepared> prepared, const Mappi
     append_to(base_, adam_base_, nb);
     st.base_added += int64_t(nb.size());
     if (reflections) {
-      const GaussianHost nr = densify_reflection(v, ctx.planes, params_.densify, kNewShDegree, mix(fseed));
+      const GaussianHost nr = densify_reflection(v, ctx.planes, params_.densify, kNewShDegree, rseed);
       append_to(refl_, adam_refl_, nr);
       st.reflection_added += int64_t(nr.size());
     }

@@ -3,7 +3,9 @@
 // the fused frames to the mapper and runs a step (prepare(): 1 and pass 1; run(): the rest):
 //   1. frames: N_local = 2 evenly sampled from the frames added since the last step (the newest
 //      included) + N_global = 7 random keyframes (seeded: params.seed, step count, newest index);
-//   2. densify base and reflection Gaussians on the N_local frames (core/gaussians/densify.h);
+//   2. densify base and reflection Gaussians on the N_local frames (core/gaussians/densify.h; with
+//      densify.reflection_stereo_depth the reflection candidates' depths come from a plane sweep
+//      against the step's other frames, core/slam/reflection_stereo.h);
 //   3. `iterations` = 30 Adam iterations, each on one of the selected frames (a seeded shuffle of
 //      the set, cycled): render C, D_b, C_r → L = (1−λ)L1 + λ(1−SSIM) + λ_d L1(D_b) + λ_g‖Sobel C_r‖₁
 //      → backward → Adam on the visible Gaussians of each set;
@@ -25,6 +27,7 @@
 #include "core/gaussians/reflective_plane.h"
 #include "core/render/render_types.h"
 #include "core/render/renderer.h"
+#include "core/slam/reflection_stereo.h"
 #include "core/tsdf/tsdf_raycast.h"
 
 #include <Eigen/Geometry>
@@ -52,6 +55,7 @@ struct MapperParams {            // paper defaults (DESIGN.md §5); validate() t
   uint64_t seed = 0;             // keyframe sampling, frame order, densification sampling
   bool reflections = true;       // false = base only (the --no-reflections ablation)
   DensifyParams densify;         // δ_b, δ_w,b, δ_r, δ_v, δ_w,r, sampling ratio, initialisation
+  ReflectionStereoParams reflection_stereo;  // with densify.reflection_stereo_depth (reflection_stereo.h)
   PruneParams prune_base = PruneParams::base();              // 0.005 / 0.003 / 0.1
   PruneParams prune_reflection = PruneParams::reflection();  // 0.005 / 0.005 / 0.2
   AdamParams adam_base{AdamLearningRates::base()};

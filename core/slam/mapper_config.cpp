@@ -15,6 +15,7 @@ void MapperParams::validate() const {
   if (sh_degree < 0 || sh_degree > 3) bad("sh_degree = " + std::to_string(sh_degree) + " outside [0, 3]");
   loss_weights().validate();
   densify.validate();
+  reflection_stereo.validate();
   prune_base.validate();
   prune_reflection.validate();
   adam_base.validate();
@@ -53,6 +54,13 @@ void add_mapper_config_fields(ConfigTable& t, MapperParams& p) {
       "no base Gaussians where the reflection set may densify (R = 1, C_var > δ_v on a reflective plane)");
   t.b("densify.reflection_mirrored_depth", p.densify.reflection_mirrored_depth,
       "reflection Gaussians at the mirrored TSDF surface instead of samples 2-8 m past the plane");
+  t.b("densify.reflection_stereo_depth", p.densify.reflection_stereo_depth,
+      "reflection Gaussians at the most photo-consistent depth behind the plane (a plane sweep over the step's frames)");
+  t.f("reflection_stereo.near", p.reflection_stereo.near, "plane sweep: nearest virtual depth past the plane, metres");
+  t.f("reflection_stereo.far", p.reflection_stereo.far, "plane sweep: farthest virtual depth past the plane, metres");
+  t.i("reflection_stereo.max_hypotheses", p.reflection_stereo.max_hypotheses, "plane sweep: most depths per pixel");
+  t.i("reflection_stereo.max_views", p.reflection_stereo.max_views, "plane sweep: other frames compared per frame");
+  t.i("reflection_stereo.patch_radius", p.reflection_stereo.patch_radius, "plane sweep: patch radius, pixels");
   t.b("densify.reflection_residual_color", p.densify.reflection_residual_color,
       "reflection colour from max(C_gt − C_b, 0) instead of C_gt");
   t.f("prune.base.min_opacity", p.prune_base.min_opacity, "base: prune below this opacity");

@@ -2,7 +2,7 @@
 // Depth of the virtual (mirrored) scene behind reflective planes, from the TSDF: the planar
 // symmetry the paper builds on (§3, "reflected content can be interpreted as virtual scene behind
 // the plane"), used to place new reflection Gaussians where the mirrored surface is instead of the
-// paper's 10 samples 2–8 m past the plane (MapperParams::densify.reflection_depth = "mirrored").
+// paper's 10 samples 2–8 m past the plane (densify.reflection_mirrored_depth).
 //
 // For a plane n·x + d = 0 (unit n), H = I − 2nnᵀ reflects directions. The mirrored camera has
 // centre H t − 2 d n and rotation H R F (F = diag(−1, 1, 1) keeps it a rotation), with

@@ -157,6 +157,39 @@ TEST(Densify, ReflectionSamplesLiePastThePlaneAlongTheRay) {
   EXPECT_NEAR(r.sh[0].z() * kC0 + 0.5f, 0.0f, 1e-6f);
 }
 
+// reflection_candidates() marks exactly the pixels densify_reflection() samples with the same
+// arguments (each makes the S ray samples when no virtual depth is given).
+TEST(Densify, ReflectionCandidatesAreThePixelsDensificationSamples) {
+  WallView w;
+  for (auto& c : w.C.pixels()) c = Color::Zero();
+  for (int x = 0; x < 32; ++x) w.R(x, 1) = 0;       // row 1: not reflective
+  for (int x = 0; x < 32; ++x) w.W_r(x, 2) = 0.5f;  // row 2: covered
+  for (int x = 0; x < 32; ++x) w.I(x, 3) = 9;       // row 3: plane not in L_ref
+  for (int y = 0; y < 24; ++y) w.C(5, y) = w.C_gt(5, y);  // column 5: no error
+  const std::vector<ReflectivePlane> planes = {{4, Eigen::Vector4f(0, 0, -2, 4)}};
+  DensifyParams p;
+  p.sample_ratio = 0.4f;
+  for (const uint64_t seed : {3ull, 4ull}) {
+    const MaskImage m = reflection_candidates(w.view(), planes, p, seed);
+    const GaussianHost g = densify_reflection(w.view(), planes, p, 0, seed);
+    std::vector<int> made(32 * 24, 0);
+    for (size_t s = 0; s < g.size(); s += 10) {
+      const Eigen::Vector2f q = w.K.project(g.means[s]);
+      ++made[size_t(std::lround(q.y())) * 32 + size_t(std::lround(q.x()))];
+    }
+    int64_t marked = 0;
+    for (int y = 0; y < 24; ++y)
+      for (int x = 0; x < 32; ++x) {
+        EXPECT_EQ(int(m(x, y)), made[size_t(y) * 32 + size_t(x)]) << x << "," << y << " seed " << seed;
+        if (y >= 1 && y <= 3) EXPECT_EQ(m(x, y), 0) << x << "," << y;
+        if (x == 5) EXPECT_EQ(m(x, y), 0) << x << "," << y;
+        marked += m(x, y);
+      }
+    EXPECT_EQ(size_t(marked) * 10, g.size());
+    EXPECT_NEAR(double(marked) / (20 * 31), 0.4, 0.08);
+  }
+}
+
 // The opacity of the samples along a reflection ray: given, or derived so that the S samples
 // together are as opaque as one new Gaussian (1 − (1 − 0.5)^(1/10) = 0.0670 for S = 10).
 TEST(Densify, ReflectionSampleOpacityGivenOrDerived) {
@@ -191,6 +224,7 @@ TEST(Densify, ReflectionSampleOpacityGivenOrDerived) {
 // With the mirrored-surface option a pixel whose virtual view meets geometry behind the plane gets
 // one Gaussian there, with a new Gaussian's opacity; the other pixels keep the S ray samples with
 // the sample opacity. init_gaussians takes one opacity per point and rejects one outside (0, 1).
+// The plane sweep's depths (reflection_stereo_depth) take the same path.
 TEST(Densify, MirroredSurfaceGaussiansTakeTheInitialOpacity) {
   WallView w;
   for (auto& c : w.C.pixels()) c = Color::Zero();
@@ -200,10 +234,17 @@ TEST(Densify, MirroredSurfaceGaussiansTakeTheInitialOpacity) {
     for (int x = 0; x < 16; ++x) virtual_depth(x, y) = 3.0f;  // left half: a surface 1 m behind the plane
   DensifyParams p;
   p.sample_ratio = 1.0f;
-  p.reflection_mirrored_depth = true;
   DensifyView v = w.view();
   v.virtual_depth = &virtual_depth;
+  // neither option: the depths are not read
+  EXPECT_EQ(densify_reflection(v, planes, p, 0, 3).size(), size_t(32 * 24 * 10));
+  p.reflection_stereo_depth = true;
+  const GaussianHost swept = densify_reflection(v, planes, p, 0, 3);
+  p.reflection_stereo_depth = false;
+  p.reflection_mirrored_depth = true;
   const GaussianHost g = densify_reflection(v, planes, p, 0, 3);
+  ASSERT_EQ(swept.size(), g.size());
+  for (size_t i = 0; i < g.size(); ++i) ASSERT_EQ(swept.means[i], g.means[i]) << i;
   ASSERT_EQ(g.size(), size_t(16 * 24 * 1 + 16 * 24 * 10));
   const auto opacity = [](float logit) { return 1.0f / (1.0f + std::exp(-logit)); };
   size_t at_surface = 0, on_rays = 0;

@@ -262,21 +262,27 @@ TEST(Mapper, ReflectionsImproveTheMirrorOnNovelViews) {
   }
   ASSERT_GT(views, 3);
   // the same over the training views (never a held-out figure; printed for context)
-  double tr_with = 0, tr_without = 0;
-  int64_t tr_n = 0;
+  double tr_with = 0, tr_without = 0, tr_rest = 0;
+  int64_t tr_n = 0, tr_rest_n = 0;
   for (size_t v = 0; v < s.frames.size(); v += 4) {
     const MaskImage mask = s.reflective_pixels(s.frames[v]);
     const ColorImage a = render_view(*with, s, s.poses[v]), b = render_view(*without, s, s.poses[v]);
     for (size_t i = 0; i < mask.size(); ++i) {
-      if (!mask[i]) continue;
+      if (!mask[i]) {
+        tr_rest += (a[i] - s.frames[v].color[i]).squaredNorm();
+        tr_rest_n += 3;
+        continue;
+      }
       tr_with += (a[i] - s.frames[v].color[i]).squaredNorm();
       tr_without += (b[i] - s.frames[v].color[i]).squaredNorm();
       tr_n += 3;
     }
   }
   if (tr_n > 0)
-    std::printf("[ ablation ] training views, mirror pixels: base only %.2f dB, base + reflection %.2f dB\n",
-                10 * std::log10(double(tr_n) / tr_without), 10 * std::log10(double(tr_n) / tr_with));
+    std::printf("[ ablation ] training views, mirror pixels: base only %.2f dB, base + reflection %.2f dB; "
+                "the other pixels %.2f dB\n",
+                10 * std::log10(double(tr_n) / tr_without), 10 * std::log10(double(tr_n) / tr_with),
+                10 * std::log10(double(tr_rest_n) / tr_rest));
   if (verbose()) {  // pictures of one novel view and one training view for inspection
     for (auto [name, T, gt] : {std::tuple{"novel", s.novel_poses[0], &s.novel[0].color},
                                std::tuple{"train", s.poses[20], &s.frames[20].color}}) {
@@ -462,6 +468,41 @@ TEST(Mapper, ReflectionGaussiansFollowAPlaneMerge) {
     for (const Color& c : C_r.pixels()) drawn = drawn || c != Color::Zero();
   }
   EXPECT_TRUE(drawn);  // the merged plane's pixels show the reflection Gaussians
+}
+
+// densify.reflection_stereo_depth: the step sweeps each local frame's candidate pixels against its
+// other frames and places one Gaussian (the base's initial opacity) behind the mirror where another
+// view sees the ray through it, instead of the paper's ten samples at the sample opacity.
+TEST(Mapper, PlaneSweepPlacesOneReflectionGaussianBehindTheMirror) {
+  const test::MapperScene s = small_scene();
+  ASSERT_EQ(s.planes.size(), 1u);
+  const Eigen::Vector4f plane = s.planes[0].plane / s.planes[0].plane.head<3>().norm();
+  auto reflection_after_one_step = [&](bool stereo) {
+    MapperParams p = short_steps();
+    p.densify.reflection_stereo_depth = stereo;
+    GaussianMapper m(p, s.K, Device::cpu());
+    for (size_t i = 0; i < 6; ++i) m.add_frame(s.frame(i), i % 3 == 0);
+    m.step(s.context());
+    return m.reflection_host();
+  };
+  const auto opacity = [](float logit) { return 1.0f / (1.0f + std::exp(-logit)); };
+  const GaussianHost samples = reflection_after_one_step(false), swept = reflection_after_one_step(true);
+  ASSERT_GT(samples.size(), 0u);
+  ASSERT_GT(swept.size(), 0u);
+  const float camera_side = plane.head<3>().dot(s.poses[0].translation()) + plane.w();
+  size_t single = 0;
+  for (size_t i = 0; i < swept.size(); ++i) {
+    const float side = plane.head<3>().dot(swept.means[i]) + plane.w();
+    EXPECT_LT(side * camera_side, 0.0f) << i << ": not behind the mirror";
+    single += std::abs(opacity(swept.logit_opacities[i]) - 0.5f) < 0.05f;
+  }
+  // nearly every candidate pixel is seen through the mirror by another frame of the step (the
+  // others keep their ten samples)
+  const size_t pixels = single + (swept.size() - single) / size_t(MapperParams{}.densify.reflection_samples);
+  EXPECT_GT(single, pixels * 9 / 10);
+  EXPECT_LT(swept.size(), samples.size() / 5);
+  std::printf("[ plane sweep ] %zu reflection Gaussians (%zu at a swept depth) vs %zu ray samples\n", swept.size(),
+              single, samples.size());
 }
 
 }  // namespace
