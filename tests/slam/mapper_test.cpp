@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <random>
 #include <thread>
 
 namespace rrg {
@@ -354,6 +355,18 @@ TEST(Mapper, PublishReusesOnlySnapshotsNoReaderHolds) {
 TEST(Mapper, ShowsAnyPlaneAndDistinctPlanes) {
   EXPECT_EQ(distinct_planes(std::vector<int32_t>{7, 0, 3, 7, 3, 0, 12}), (std::vector<int32_t>{3, 7, 12}));
   EXPECT_TRUE(distinct_planes(std::vector<int32_t>{0, 0}).empty());
+  EXPECT_TRUE(distinct_planes(std::vector<int32_t>{}).empty());
+  // against sort + unique on runs and on scattered ids (negative ids are ids too; only 0 is none)
+  std::mt19937 rng(5);
+  for (const int run : {1, 7, 300}) {
+    std::vector<int32_t> ids;
+    while (ids.size() < 5000) ids.insert(ids.end(), size_t(run), int32_t(rng() % 41) - 10);
+    std::vector<int32_t> want = ids;
+    std::sort(want.begin(), want.end());
+    want.erase(std::unique(want.begin(), want.end()), want.end());
+    want.erase(std::remove(want.begin(), want.end(), 0), want.end());
+    EXPECT_EQ(distinct_planes(ids), want) << "runs of " << run;
+  }
   Image<int32_t> I(4, 2, 0);
   const std::vector<int32_t> planes{3, 7, 12};
   EXPECT_FALSE(shows_any_plane(I, planes));  // I = 0: no plane, pass 3 draws nothing
