@@ -248,7 +248,7 @@ void base_bwd_cpu(BaseBwdArgs a, CpuRasterScratch& scratch) {
         const int l = tp.local(x, y);
         const Vec3<float> v_C_b = a.v_C_b(x, y);
         const float v_D_b = a.v_D_b(x, y);
-        if (v_C_b.isZero() && v_D_b == 0.0f) continue;
+        if (exactly_zero(v_C_b) && v_D_b == 0.0f) continue;
         active[l] = any = true;
         D_t[l] = a.D_t(x, y);
         up[l] = base_resolve_bwd(a.W_g(x, y), D_t[l], Vec3<float>(a.C_b(x, y)), a.D_b(x, y), v_C_b, v_D_b);
@@ -332,7 +332,7 @@ void refl_bwd_cpu(ReflBwdArgs a, CpuRasterScratch& scratch) {
         I[l] = a.I(x, y);
         if (!refl_pixel_active(a.mode, a.plane, I[l])) continue;
         v_C[l] = a.v_C_r(x, y);
-        if (v_C[l].isZero()) continue;
+        if (exactly_zero(v_C[l])) continue;
         C_final[l] = a.C_r(x, y);
         W_final[l] = a.W_r(x, y);
         alive[l] = true;

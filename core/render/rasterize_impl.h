@@ -56,7 +56,7 @@ void base_bwd(Backend b, BaseBwdArgs a) {
     if (!tile_pixel(i, a.view.width, a.view.height, a.view.tiles_x(), x, y, tile)) return;
     const Vec3<float> v_C_b = a.v_C_b(x, y);
     const float v_D_b = a.v_D_b(x, y);
-    if (v_C_b.isZero() && v_D_b == 0.0f) return;
+    if (exactly_zero(v_C_b) && v_D_b == 0.0f) return;
     const float px = float(x), py = float(y), D_t = a.D_t(x, y);
     const auto up = base_resolve_bwd(a.W_g(x, y), D_t, Vec3<float>(a.C_b(x, y)), a.D_b(x, y), v_C_b, v_D_b);
     const TileRange r = a.bins.ranges[tile];
@@ -106,7 +106,7 @@ void refl_bwd(Backend b, ReflBwdArgs a) {
     const int32_t I = a.I(x, y);
     if (!refl_pixel_active(a.mode, a.plane, I)) return;
     const Vec3<float> v_C = a.v_C_r(x, y);
-    if (v_C.isZero()) return;
+    if (exactly_zero(v_C)) return;
     const Vec3<float> C_final = a.C_r(x, y);
     const float W_final = a.W_r(x, y);
     const float px = float(x), py = float(y);
