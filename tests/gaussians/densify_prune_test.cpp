@@ -234,6 +234,7 @@ TEST(Densify, MirroredSurfaceGaussiansTakeTheInitialOpacity) {
     for (int x = 0; x < 16; ++x) virtual_depth(x, y) = 3.0f;  // left half: a surface 1 m behind the plane
   DensifyParams p;
   p.sample_ratio = 1.0f;
+  p.reflection_stereo_depth = false;  // on by default
   DensifyView v = w.view();
   v.virtual_depth = &virtual_depth;
   // neither option: the depths are not read
