@@ -335,7 +335,7 @@ using ReflectionPassed = std::array<int64_t, 7>;  // on plane, R = 1, wrong, var
 class ReflectionTests {
  public:
   ReflectionTests(const DensifyView& v, std::span<const ReflectivePlane> planes, const DensifyParams& p, uint64_t seed)
-      : v_(v), p_(p), seed_(seed) {
+      : v_(v), p_(p), seed_(seed), by_id_(unit_planes_by_id(planes, "densify_reflection")) {
     p.validate();
     check_image(v.C_gt, v.K, "C_gt");
     check_image(v.C, v.K, "C");
@@ -344,11 +344,6 @@ class ReflectionTests {
     check_image(v.R, v.K, "R");
     if (p.reflection_variance_gate) check_image(v.C_var, v.K, "C_var");
     check_image(v.I, v.K, "I");
-    for (const ReflectivePlane& pl : planes) {
-      const float len = pl.plane.head<3>().norm();
-      if (!(len > 0)) throw std::invalid_argument("densify_reflection: plane " + std::to_string(pl.id) + " has a zero normal");
-      by_id_[pl.id] = pl.plane / len;
-    }
   }
 
   const Eigen::Vector4f* operator()(int x, int y, ReflectionPassed* passed) const {

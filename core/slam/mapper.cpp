@@ -141,7 +141,7 @@ struct GaussianMapper::StepFrame {
   RaycastInputs rc;
   Image<float> C_var;  // host, for reflection densification
   Image<uint8_t> R;
-  Image<int32_t> I_host;  // plane ids, with the plane sweep only (the other views of a local frame)
+  Image<int32_t> I_host;  // plane ids on the host: local frames (densification), all frames with the plane sweep
   bool shows_reflection = true;  // some pixel's I(u) is the plane of a reflection Gaussian
 };
 
@@ -293,7 +293,8 @@ MappingStats GaussianMapper::run(std::shared_ptr<Prepared> prepared, const Mappi
     renderer_.render({K_, f.frame->T_wc}, base_, refl_, f.rc, out);
     const ColorImage C = out.C.to_host(), C_b = out.C_b.to_host();
     const Image<float> W_b = out.W_g.to_host(), W_r = out.W_r.to_host();
-    const Image<int32_t> I = f.rc.I.to_host();
+    if (f.I_host.empty()) f.I_host = f.rc.I.to_host();
+    const Image<int32_t>& I = f.I_host;
     DensifyView v;
     v.K = K_;
     v.T_wc = f.frame->T_wc;
@@ -353,7 +354,10 @@ MappingStats GaussianMapper::run(std::shared_ptr<Prepared> prepared, const Mappi
   t0 = Clock::now();
   if (params_.render.variant != ReflectionVariant::NoPlaneGrouping && refl_.size() > 0) {
     const std::vector<int32_t> planes = distinct_planes(refl_);
-    for (StepFrame& f : frames) f.shows_reflection = shows_any_plane(f.rc.I.to_host(), planes);
+    for (StepFrame& f : frames) {
+      if (f.I_host.empty()) f.I_host = f.rc.I.to_host();
+      f.shows_reflection = shows_any_plane(f.I_host, planes);
+    }
   }
   std::vector<size_t> order(frames.size());
   std::iota(order.begin(), order.end(), size_t(0));

@@ -55,12 +55,7 @@ Image<float> reflection_stereo_depth(const Intrinsics& K, const Eigen::Isometry3
   check_size(&C, "the colour image");
   check_size(&I, "the plane-id map");
   if (want) check_size(want, "the pixel mask");
-  std::unordered_map<int32_t, Eigen::Vector4f> by_id;
-  for (const ReflectivePlane& pl : planes) {
-    const float len = pl.plane.head<3>().norm();
-    if (!(len > 0)) throw std::invalid_argument("reflection_stereo_depth: plane " + std::to_string(pl.id) + " has a zero normal");
-    by_id[pl.id] = pl.plane / len;
-  }
+  const auto by_id = unit_planes_by_id(planes, "reflection_stereo_depth");
 
   // The nearest other views (by camera centre) with a baseline of at least min_baseline that show
   // one of the planes.
