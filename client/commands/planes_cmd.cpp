@@ -114,7 +114,7 @@ struct EvalOptions {
   int period = 10, max_frames = 0;
   float voxel = 0.02f, delta_v = 0.01f, delta_area = 0.05f, border_voxels = IdentificationParams{}.variance_border_voxels;
   int border_pixels = IdentificationParams{}.variance_border_pixels;
-  bool no_fuse = false, json = false, no_color_edges = false;
+  bool no_fuse = false, json = false, no_color_edges = false, no_exposure = false;
 };
 
 void run_eval(const EvalOptions& o) {
@@ -133,6 +133,7 @@ void run_eval(const EvalOptions& o) {
   e.params.variance_border_voxels = o.border_voxels;
   e.params.variance_border_pixels = o.border_pixels;
   e.params.variance_skip_color_edges = !o.no_color_edges;
+  e.params.exposure_compensation = !o.no_exposure;
   spdlog::info("planes eval: {} semantics {} period {} voxel {} m on {}, δ_v {} δ_area {}", o.dataset, o.semantics,
                o.period, o.voxel, e.device.to_string(), o.delta_v, o.delta_area);
   const StopOnSignal signals;  // Ctrl-C: stop after the current frame and score the frames done
@@ -246,6 +247,9 @@ void register_planes_command(CLI::App& app) {
       ->check(CLI::Range(0, 16));
   e->add_flag("--no-color-edges", ev->no_color_edges,
               "keep pixels near colour edges of the input in the variance check")
+      ->capture_default_str();
+  e->add_flag("--no-exposure", ev->no_exposure,
+              "fuse the frames' intensity into C_var as it is, without their exposure gain against the map")
       ->capture_default_str();
   e->add_flag("--no-fuse", ev->no_fuse, "no TSDF (C_var = 0): segmentation and global ids only");
   e->add_flag("--json", ev->json, "print JSON instead of a table");

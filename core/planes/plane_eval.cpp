@@ -2,6 +2,7 @@
 
 #include "core/io/dataset.h"
 #include "core/io/synth_layout.h"
+#include "core/planes/exposure_gain.h"
 #include "core/planes/semantic_labels.h"
 #include "core/tsdf/tsdf_integrate.h"
 #include "core/tsdf/tsdf_raycast.h"
@@ -99,11 +100,15 @@ PlaneEvalReport run_plane_eval(const PlaneEvalOptions& options) {
     DeviceImage<int32_t> plane_ids;
     DeviceImage<uint8_t> mask;
     std::vector<int32_t> remap;
+    float exposure_gain = 1.0f;  // as the session estimates it (core/planes/exposure_gain.h)
     if (identify) {
       Image<float> cvar(K.width, K.height, 0.0f);
       if (volume) {
         const auto t0 = std::chrono::steady_clock::now();
-        cvar = raycast(*volume, K, T_wc, {}, {.color = false, .reflection = true, .normals = false}).color_variance.to_host();
+        const bool exposure = options.params.exposure_compensation;
+        const RaycastResult rc = raycast(*volume, K, T_wc, {}, {.color = exposure, .reflection = true, .normals = false});
+        cvar = rc.color_variance.to_host();
+        if (exposure) exposure_gain = estimate_exposure_gain(frame.color, frame.depth, rc, tp.truncation).gain;
         raycast_ms += ms_since(t0);
         ++raycasts;
       }
@@ -139,7 +144,7 @@ PlaneEvalReport run_plane_eval(const PlaneEvalOptions& options) {
       const auto t0 = std::chrono::steady_clock::now();
       const auto depth = DeviceImage<float>::from_host(frame.depth, volume->device());
       const auto color = DeviceImage<Color>::from_host(frame.color, volume->device());
-      ReflectionObservation obs{&plane_ids, &mask, remap};
+      ReflectionObservation obs{&plane_ids, &mask, remap, exposure_gain};
       integrate(*volume, depth, color, K, T_wc, identify ? &obs : nullptr);
       fuse_ms += ms_since(t0);
     }

@@ -53,6 +53,10 @@ struct IdentificationParams {
   // with nothing reflected: marker strokes on a whiteboard, book spines, printed texture. A
   // reflection moves with the view, so its variance is not confined to the current frame's edges.
   bool variance_skip_color_edges = true;
+  // Exposure: fusion divides an identification frame's intensity by its gain against the map's
+  // colour before the Welford update, so that auto-exposure is not taken for view dependence
+  // (core/planes/exposure_gain.h; the callers that fuse apply it). false = the paper's statistic.
+  bool exposure_compensation = true;
   void validate() const;             // throws std::invalid_argument
 };
 

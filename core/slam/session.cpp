@@ -2,6 +2,7 @@
 // mapping every N_o frames on the mapping thread (or inline with config.sync).
 #include "core/slam/session_impl.h"
 
+#include "core/planes/exposure_gain.h"
 #include "core/planes/remote_segmenter.h"
 #include "core/planes/semantic_labels.h"
 #include "core/tsdf/tsdf_integrate.h"
@@ -163,9 +164,17 @@ MappingContext Session::Impl::mapping_context() {
 void Session::Impl::identify(const SessionFrame& frame, const Eigen::Isometry3f& T_wc, FrameReport& report,
                              DeviceImage<int32_t>& plane_ids, DeviceImage<uint8_t>& mask) {
   const auto t0 = Clock::now();
-  // C_var only: the identification reads no colour from the map (its colour edges are the input's).
-  const RaycastResult rc = locked_raycast(K, T_wc, RaycastOutputs{.color = false, .reflection = true, .normals = false});
+  // C_var for the check; C_t and D_t only for the exposure gain (the identification's colour edges
+  // are the input's).
+  const bool exposure = config.planes.exposure_compensation;
+  const RaycastResult rc = locked_raycast(K, T_wc, RaycastOutputs{.color = exposure, .reflection = true, .normals = false});
   const Image<float> cvar = rc.color_variance.to_host();
+  if (exposure) {
+    const ExposureGain g = estimate_exposure_gain(frame.color, frame.depth, rc, config.tsdf.truncation);
+    report.exposure_gain = g.gain;
+    spdlog::debug("frame {}: exposure gain {:.3f} over {} pixels{}", frame.index, g.gain, g.pixels,
+                  g.estimated ? "" : " (too few: 1)");
+  }
   IdentificationFrame f{&frame.depth, &frame.color, frame.labels ? &*frame.labels : nullptr, K, T_wc, frame.index,
                         config.tsdf.voxel_size};
   if (identifier.cue().name() == "labels" && !frame.labels) f.labels = nullptr;
@@ -292,7 +301,7 @@ FrameReport Session::process(const SessionFrame& frame) {
     const auto tf = Clock::now();
     {
       std::unique_lock lock(s.volume_mutex);  // the one writer
-      const ReflectionObservation obs{&plane_ids, &mask, s.remap};  // written by this thread only
+      const ReflectionObservation obs{&plane_ids, &mask, s.remap, report.exposure_gain};  // remap: this thread's
       // D_k after the bilateral filter: at fine resolutions the raw depth's noise exceeds the pixel
       // spacing and fusion's normals (point-to-plane sdf, grazing test) would drop the surface
       // (docs/tracking.md); with given poses nothing was preprocessed and the raw depth is fused.

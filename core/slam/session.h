@@ -63,6 +63,7 @@ struct FrameReport {
   TrackingState state = TrackingState::Ok;
   bool fused = false;              // false when lost (the frame is not fused)
   bool identified = false;         // plane identification ran on this frame
+  float exposure_gain = 1.0f;      // its exposure against the map, fused into C_var (1: none estimated)
   bool mapping_started = false;    // a mapping step was started (async) or run (sync) after it
   uint64_t map_version = 0;        // after this frame
   std::string note;                // tracking note

@@ -207,6 +207,8 @@ std::vector<ConfigField> config_fields(SessionConfig& c) {
       "... plus this many pixels (the fusion's nearest-pixel footprint)");
   t.b("planes.variance_skip_color_edges", c.planes.variance_skip_color_edges,
       "pixels as near to a colour edge of the input (step > 2 sqrt(delta_v)) are left out too");
+  t.b("planes.exposure_compensation", c.planes.exposure_compensation,
+      "the variance statistic takes each identification frame's intensity over its exposure gain against the map");
   t.i("planes.vote.windows", c.planes.vote.windows, "vote history, windows");
   t.i("planes.vote.min_reflective", c.planes.vote.min_reflective, "windows needed to accept");
   t.f("planes.segmentation.noise_a", c.planes.segmentation.noise_a, "sensor noise σ_n = a + b (z − z0)², a in metres");

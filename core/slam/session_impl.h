@@ -65,6 +65,8 @@ struct Session::Impl {
   explicit Impl(SessionConfig c, std::unique_ptr<SemanticCue> cue);
 
   // process() stages
+  // Fills the fusion's reflection observation of this frame: I_k^g, the reflection mask and the
+  // exposure gain (report.exposure_gain).
   void identify(const SessionFrame& frame, const Eigen::Isometry3f& T_wc, FrameReport& report,
                 DeviceImage<int32_t>& plane_ids, DeviceImage<uint8_t>& mask);
   void schedule_mapping(FrameReport& report);

@@ -2,6 +2,7 @@
 
 #include "core/io/image_io.h"
 #include "core/io/ply.h"
+#include "core/synth/exposure.h"
 #include "core/synth/hash.h"
 #include "core/synth/mesh_export.h"
 #include "core/synth/sequence_files.h"
@@ -62,8 +63,9 @@ struct ViewWriter {
   DepthNoiseParams noise;
   double render_seconds = 0.0, render_cpu_seconds = 0.0;
 
+  // exposure: the colour's gain (1 = as rendered).
   std::vector<std::function<void()>> render(const Eigen::Isometry3d& T_wc, const fs::path& root, size_t index,
-                                            uint32_t noise_frame) {
+                                            uint32_t noise_frame, float exposure = 1.0f) {
     const auto t0 = Clock::now();
     const double c0 = cpu_seconds();
     RenderParams rp = params.render;
@@ -71,6 +73,7 @@ struct ViewWriter {
     auto out = std::make_shared<RenderOutput>(render_view(scene, K, T_wc.cast<float>(), rp));
     if (noise.gaussian || noise.edge_dropout || noise.invalid_on_mirrors)
       apply_depth_noise(out->depth, out->material, scene, noise, noise_frame, params.seed);
+    if (exposure != 1.0f) apply_exposure(out->color, exposure);
     render_seconds += seconds_since(t0);
     render_cpu_seconds += cpu_seconds() - c0;
     const std::string name = frame_file_name(index);
@@ -178,7 +181,8 @@ SynthStats generate_sequence(const SynthParams& params) {
 
   fs::create_directories(params.out);
   for (size_t i = 0; i < plan.frames.size(); ++i) {
-    run_parallel(writer.render(plan.frames[i].T_wc, params.out, i, uint32_t(i)), threads);
+    const float gain = params.exposure ? exposure_gain(plan.frames[i].timestamp, params.seed) : 1.0f;
+    run_parallel(writer.render(plan.frames[i].T_wc, params.out, i, uint32_t(i), gain), threads);
     if ((i + 1) % 50 == 0 || i + 1 == plan.frames.size())
       spdlog::info("synth: frame {}/{} ({:.1f} frames/s rendering)", i + 1, plan.frames.size(),
                    double(i + 1) / std::max(writer.render_seconds, 1e-9));

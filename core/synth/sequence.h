@@ -29,6 +29,7 @@ struct SynthParams {
   int novel = 25;          // held-out views in out/novel
   bool noise = false;      // Kinect-like depth noise and edge dropouts
   MirrorDepth mirror_depth = MirrorDepth::Surface;
+  bool exposure = false;   // auto-exposure drift on the frames' colour (core/synth/exposure.h)
   int threads = 0;         // 0 = all cores; never changes the output
   bool overwrite = false;  // allow writing into a non-empty out folder
   bool write_mesh = true;

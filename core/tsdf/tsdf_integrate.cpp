@@ -4,6 +4,7 @@
 #include "core/common/dispatch.h"
 #include "core/tsdf/tsdf_integrate_impl.h"
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -33,6 +34,9 @@ int64_t integrate_any(TsdfVolume& volume, const DeviceImage<float>& depth, const
       throw std::invalid_argument("integrate: a reflection observation needs plane ids and a reflection mask");
     check_image(*refl->plane_ids, "plane id image", K, dev);
     check_image(*refl->reflection_mask, "reflection mask", K, dev);
+    if (!(std::isfinite(refl->exposure_gain) && refl->exposure_gain > 0.0f))
+      throw std::invalid_argument("integrate: exposure gain must be finite and > 0, got " +
+                                  std::to_string(refl->exposure_gain));
     remap = Buffer<int32_t>::from_host(refl->plane_remap, dev);
   }
   TsdfVolume::FrameScratch& scratch = volume.frame_scratch();
@@ -51,6 +55,7 @@ int64_t integrate_any(TsdfVolume& volume, const DeviceImage<float>& depth, const
                                   p.voxel_size, p.truncation, p.max_weight, p.reflection_window, active,
                                   volume.block_keys(), volume.geometry(), volume.attributes(),
                                   volume.block_versions(), volume.version(), refl != nullptr,
+                                  refl ? 1.0f / refl->exposure_gain : 1.0f,
                                   refl ? refl->plane_ids->view() : ImageView<const int32_t>{},
                                   refl ? refl->reflection_mask->view() : ImageView<const uint8_t>{},
                                   remap.span()};

@@ -18,6 +18,9 @@ struct ReflectionObservation {
   const DeviceImage<int32_t>* plane_ids = nullptr;        // I_k^g per pixel (global or local ids), 0 = none
   const DeviceImage<uint8_t>* reflection_mask = nullptr;  // predicted reflection mask, non-zero = 1
   std::span<const int32_t> plane_remap;                   // id -> canonical id (ids beyond: themselves)
+  // The frame's exposure relative to the map (core/planes/exposure_gain.h): the Welford statistic
+  // takes the intensity x_t / exposure_gain. 1 = as the frame is (the paper). Must be finite, > 0.
+  float exposure_gain = 1.0f;
 };
 
 // Fuses depth (metres, 0 = invalid) and colour (float RGB [0,1] or 8-bit) seen by a camera with

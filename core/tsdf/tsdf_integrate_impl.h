@@ -52,6 +52,7 @@ struct IntegrateArgs {
   Span<uint64_t> versions;
   uint64_t version;
   bool reflection;                         // identification frame: update μ, M_2, n, r, π
+  float inv_exposure_gain;                 // 1 / ReflectionObservation::exposure_gain (Welford input)
   ImageView<const int32_t> plane_ids;      // I_k^g
   ImageView<const uint8_t> mask;           // predicted reflection mask
   Span<const int32_t> remap;               // plane id -> canonical id
@@ -73,7 +74,7 @@ RRG_HD RRG_INLINE void fuse_voxel(const IntegrateArgs<ColorT>& args, int64_t k, 
   fuse_sdf_color(args.geometry[k], attr, f.t, c, args.max_weight);
   if (args.reflection && f.kind == VoxelFusion::kBand) {
     const float m = args.mask(u, v) ? 1.0f : 0.0f;
-    fuse_reflection(attr, c, m, canonical_plane(args.remap, args.plane_ids(u, v)), args.window);
+    fuse_reflection(attr, c * args.inv_exposure_gain, m, canonical_plane(args.remap, args.plane_ids(u, v)), args.window);
   }
 }
 

@@ -5,11 +5,14 @@
 #include "core/io/image_io.h"
 #include "core/io/ply.h"
 #include "core/io/trajectory.h"
+#include "core/synth/exposure.h"
 #include "tests/support/test_support.h"
 
 #include <nlohmann/json.hpp>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -167,6 +170,35 @@ TEST(SynthCli, SameBytesWhateverTheThreadCountAndNoiseIsDeterministic) {
   }
   EXPECT_GT(mirror_px, 0u);
   EXPECT_GT(zero_px, mirror_px / 2) << "the mirror glass (most of the mirror category) has no depth";
+}
+
+// --exposure scales each frame's colour by the gain of its timestamp (clipped to 1, then 8-bit)
+// and leaves depth and the held-out views alone.
+TEST(SynthCli, ExposureScalesTheFramesColourOnly) {
+  TempDir tmp("synth-exposure");
+  const std::string common = "synth --preset office --frames 40 --width 40 --height 30 --novel 1 --seed 5 ";
+  ASSERT_EQ(run_rrg(common + "--out " + (tmp / "a").string()).exit_code, 0);
+  ASSERT_EQ(run_rrg(common + "--exposure --out " + (tmp / "b").string()).exit_code, 0);
+  EXPECT_EQ(read_json(tmp / "b" / "scene.json")["parameters"]["exposure"], true);
+  EXPECT_EQ(read_json(tmp / "a" / "scene.json")["parameters"]["exposure"], false);
+  for (const char* f : {"depth/000017.png", "novel/rgb/000000.png", "groundtruth.txt"})
+    EXPECT_EQ(slurp(tmp / "a" / f), slurp(tmp / "b" / f)) << f;
+  const io::Trajectory gt = io::read_tum_trajectory(tmp / "a" / "groundtruth.txt");
+  float lo = 2.0f, hi = 0.0f;
+  for (size_t i = 0; i < gt.size(); i += 13) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "rgb/%06zu.png", i);
+    const ColorImage a = io::read_color(tmp / "a" / name), b = io::read_color(tmp / "b" / name);
+    const float g = exposure_gain(gt[i].timestamp, 5);
+    lo = std::min(lo, g);
+    hi = std::max(hi, g);
+    for (size_t k = 0; k < a.size(); ++k)
+      for (int c = 0; c < 3; ++c)  // both rounded to 8 bits: a's rounding is scaled by g
+        ASSERT_NEAR(b[k][c], std::min(1.0f, g * a[k][c]), (0.5f + 0.5f * g) / 255.0f + 1e-6f) << name;
+  }
+  EXPECT_GE(lo, 1.0f / 1.35f - 1e-6f);
+  EXPECT_LE(hi, 1.35f + 1e-6f);
+  EXPECT_GT(hi / lo, 1.2f);  // 40 frames at 30 fps span enough of the drift to matter
 }
 
 TEST(SynthCli, ErrorsAndList) {

@@ -98,6 +98,7 @@ TEST(TsdfIntegrate, RowLanesMatchThePerVoxelLoop) {
           Span<TsdfVoxel>{b.geometry.data(), int64_t(b.geometry.size())},
           Span<AttrVoxel>{b.attributes.data(), int64_t(b.attributes.size())},
           Span<uint64_t>{b.versions.data(), int64_t(b.versions.size())}, 7, reflection,
+          0.8f,  // 1 / exposure gain 1.25: both loops scale the Welford input alike
           ImageView<const int32_t>{ids.data(), K.width, K.height},
           ImageView<const uint8_t>{mask.data(), K.width, K.height},
           Span<const int32_t>{remap.data(), int64_t(remap.size())}};

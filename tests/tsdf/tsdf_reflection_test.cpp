@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cmath>
+#include <limits>
 
 namespace rrg {
 namespace {
@@ -164,11 +165,47 @@ TEST(TsdfReflection, ReflectionStrengthIsASlidingAverageOverTheWindow) {
   }
 }
 
+// Auto-exposure (core/planes/exposure_gain.h): a matte grey wall seen through gains 0.7 .. 1.4 has
+// the variance of the gains in its Welford statistic; fused with each frame's gain it has none,
+// while colour fusion (c̄) still averages the frames as they are.
+TEST(TsdfReflection, ExposureGainTakesAutoExposureOutOfTheVariance) {
+  const std::array<float, 5> gains = {0.7f, 1.0f, 1.4f, 0.85f, 1.2f};
+  const Color grey(0.6f, 0.5f, 0.4f);  // x = 0.5
+  double mean = 0, var = 0, c_mean = 0;
+  for (float g : gains) mean += 0.5 * g / double(gains.size());
+  for (float g : gains) var += (0.5 * g - mean) * (0.5 * g - mean) / double(gains.size());
+  for (float g : gains) c_mean += 0.6 * g / double(gains.size());
+  ASSERT_GT(var, 0.01);  // above δ_v without the gains
+  for (const Device& device : available_devices()) {
+    SCOPED_TRACE(device.to_string());
+    for (const bool compensate : {false, true}) {
+      TsdfVolume v(params(), device);
+      const Observation obs = half_image(2, 0, device);
+      for (float g : gains) {
+        const ReflectionObservation refl{&obs.ids, &obs.mask, {}, compensate ? g : 1.0f};
+        fuse(v, g * grey, &refl);
+      }
+      const auto voxels = surface_voxels(v, int(gains.size()));
+      ASSERT_GT(voxels.size(), 100u);
+      for (const Voxel& vox : voxels) {
+        ASSERT_NEAR(vox.mu, compensate ? 0.5 : mean, 1e-5);
+        ASSERT_NEAR(voxel_variance(vox), compensate ? 0.0 : var, 1e-6);
+        ASSERT_NEAR(voxel_color(vox).x(), c_mean, 2e-3);  // c̄: the frames as they are
+      }
+    }
+  }
+}
+
 TEST(TsdfReflection, RejectsAnIncompleteObservation) {
   TsdfVolume v(params(), Device::cpu());
   const Observation obs = half_image(1, 1, Device::cpu());
   const ReflectionObservation refl{&obs.ids, nullptr, {}};
   EXPECT_THROW(fuse(v, Color(0.5f, 0.5f, 0.5f), &refl), std::invalid_argument);
+  const Observation full = half_image(1, 1, Device::cpu());
+  for (const float gain : {0.0f, -1.0f, std::numeric_limits<float>::infinity(), std::numeric_limits<float>::quiet_NaN()}) {
+    const ReflectionObservation bad{&full.ids, &full.mask, {}, gain};
+    EXPECT_THROW(fuse(v, Color(0.5f, 0.5f, 0.5f), &bad), std::invalid_argument) << gain;
+  }
 }
 
 }  // namespace
