@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <fstream>
+#include <map>
 #include <thread>
 
 namespace rrg {
@@ -45,6 +46,33 @@ TEST_F(SessionTest, GroundTruthPosesMapAndRender) {
   for (const Color& px : v.C.pixels()) sum += px.sum();
   EXPECT_GT(sum, 0.0) << "the render is black";
   EXPECT_GT(s.mesh().triangles.size(), 100u);
+}
+
+// Auto-exposure (docs/planes.md): frames 0-9 as rendered, frames 10 and 20 (identification frames,
+// N_p = 10) through gains 1.3 and 0.75. The session estimates each identification frame's gain
+// against the map and reports it; the paper's statistic (exposure_compensation off) reports 1.
+TEST_F(SessionTest, IdentificationFramesReportTheirExposureGain) {
+  const auto d = io::open_dataset(root());
+  for (const bool compensate : {true, false}) {
+    SCOPED_TRACE(compensate ? "compensated" : "paper");
+    SessionConfig c = config(*d);
+    c.gt_poses = true;
+    c.planes.exposure_compensation = compensate;
+    Session s(c);
+    std::map<size_t, float> reported;
+    for (size_t i = 0; i <= 20; ++i) {
+      SessionFrame f = frame(*d, i, true);
+      const float gain = i == 10 ? 1.3f : (i == 20 ? 0.75f : 1.0f);
+      for (Color& px : f.color.pixels()) px = (gain * px).cwiseMin(1.0f);
+      const FrameReport r = s.process(f);
+      if (r.identified) reported[i] = r.exposure_gain;
+    }
+    ASSERT_EQ(reported.size(), 3u);
+    EXPECT_EQ(reported[0], 1.0f) << "an empty map: no estimate";
+    // The map's colour averages frames 0-9 (gain 1), then 10-19 (one at 1.3): frame 20 against it.
+    EXPECT_NEAR(reported[10], compensate ? 1.3f : 1.0f, 0.02f);
+    EXPECT_NEAR(reported[20], compensate ? 0.75f / (1.0f + 0.3f / 20.0f) : 1.0f, 0.03f);
+  }
 }
 
 TEST_F(SessionTest, TracksTheSequence) {
