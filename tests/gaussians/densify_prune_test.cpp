@@ -130,6 +130,7 @@ TEST(Densify, ReflectionSamplesLiePastThePlaneAlongTheRay) {
   const std::vector<ReflectivePlane> planes = {{4, Eigen::Vector4f(0, 0, -2, 4)}};  // z = 2 (unnormalised)
   DensifyParams p;
   p.sample_ratio = 1.0f;
+  p.reflection_residual_color = false;  // the paper's colour, C_gt (the residual is checked below)
   // Row 0 is a candidate by default (R = 1 on an accepted plane suffices), not with the paper's
   // per-pixel variance gate.
   EXPECT_EQ(densify_reflection(w.view(), planes, p, 0, 3).size(), size_t(21 * 32 * 10));
@@ -150,7 +151,7 @@ TEST(Densify, ReflectionSamplesLiePastThePlaneAlongTheRay) {
     EXPECT_NEAR(g.sh[s].x() * kC0 + 0.5f, 0.8f, 1e-6f);
     EXPECT_NEAR(g.sh[s].z() * kC0 + 0.5f, 0.2f, 1e-6f);
   }
-  // the residual option: C_gt − C_b = (0.3, 0.1, 0)
+  // the default, the residual: C_gt − C_b = (0.3, 0.1, 0)
   p.reflection_residual_color = true;
   const GaussianHost r = densify_reflection(w.view(), planes, p, 0, 3);
   EXPECT_NEAR(r.sh[0].x() * kC0 + 0.5f, 0.3f, 1e-6f);
