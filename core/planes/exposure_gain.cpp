@@ -1,5 +1,7 @@
 #include "core/planes/exposure_gain.h"
 
+#include "core/tsdf/voxel.h"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -9,8 +11,6 @@
 namespace rrg {
 
 namespace {
-
-float intensity(const Color& c) { return (c.x() + c.y() + c.z()) * (1.0f / 3.0f); }
 
 template <class A, class B>
 void check_same_size(const A& a, const B& b, const char* name) {
@@ -37,7 +37,7 @@ ExposureGain estimate_exposure_gain(const ColorImage& frame_color, const DepthIm
     for (int x = 0; x < frame_color.width(); x += p.stride) {
       const float d = frame_depth(x, y), dm = map_depth(x, y);
       if (!(d > 0.0f && dm > 0.0f) || std::fabs(d - dm) > p.max_depth_difference || map_reflection(x, y)) continue;
-      const float a = intensity(frame_color(x, y)), b = intensity(map_color(x, y));
+      const float a = welford_intensity(frame_color(x, y)), b = welford_intensity(map_color(x, y));
       if (a < p.min_intensity || a > p.max_intensity || b < p.min_intensity || b > p.max_intensity) continue;
       log_ratio.push_back(std::log(a) - std::log(b));
     }

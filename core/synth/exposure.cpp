@@ -2,7 +2,6 @@
 
 #include "core/synth/hash.h"
 
-#include <algorithm>
 #include <cmath>
 #include <numbers>
 

@@ -94,7 +94,7 @@ RRG_HD inline void fuse_sdf_color(TsdfVoxel& g, AttrVoxel& a, float t_obs, const
 // n saturates at 65535 (the updates then continue with that count).
 RRG_HD inline void fuse_reflection(AttrVoxel& v, const Eigen::Vector3f& c, float mask, int32_t plane, int window) {
   const uint32_t n1 = v.n < 65535 ? uint32_t(v.n) + 1 : 65535u;
-  const float x = (c.x() + c.y() + c.z()) * (1.0f / 3.0f);
+  const float x = welford_intensity(c);
   const float delta = x - v.mu;
   v.mu += delta / float(n1);
   v.m2 += delta * (x - v.mu);

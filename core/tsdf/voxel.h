@@ -121,6 +121,8 @@ RRG_HD inline Eigen::Vector3f voxel_color(const V& v) {
 // σ_c² = M_2 / n (0 before any identification frame).
 template <class V>
 RRG_HD inline float voxel_variance(const V& v) { return v.n > 0 ? v.m2 / float(v.n) : 0.0f; }
+// The intensity x = (r + g + b) / 3 whose Welford statistics (μ, M_2, n) a voxel keeps.
+RRG_HD inline float welford_intensity(const Eigen::Vector3f& c) { return (c.x() + c.y() + c.z()) * (1.0f / 3.0f); }
 
 // Block (x, y, z) holds voxels [8x, 8x + 7] × ... ; voxel g has its centre at g · s in the world.
 RRG_HD inline bool block_in_range(int x, int y, int z) {
