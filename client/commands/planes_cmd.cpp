@@ -114,7 +114,7 @@ struct EvalOptions {
   int period = 10, max_frames = 0;
   float voxel = 0.02f, delta_v = 0.01f, delta_area = 0.05f, border_voxels = IdentificationParams{}.variance_border_voxels;
   int border_pixels = IdentificationParams{}.variance_border_pixels;
-  bool no_fuse = false, json = false, no_color_edges = false, no_exposure = false;
+  bool no_fuse = false, json = false, no_color_edges = false, no_exposure = false, no_fill = false;
 };
 
 void run_eval(const EvalOptions& o) {
@@ -134,6 +134,7 @@ void run_eval(const EvalOptions& o) {
   e.params.variance_border_pixels = o.border_pixels;
   e.params.variance_skip_color_edges = !o.no_color_edges;
   e.params.exposure_compensation = !o.no_exposure;
+  e.params.fill.enabled = !o.no_fill;
   spdlog::info("planes eval: {} semantics {} period {} voxel {} m on {}, δ_v {} δ_area {}", o.dataset, o.semantics,
                o.period, o.voxel, e.device.to_string(), o.delta_v, o.delta_area);
   const StopOnSignal signals;  // Ctrl-C: stop after the current frame and score the frames done
@@ -145,7 +146,7 @@ void run_eval(const EvalOptions& o) {
                                         {"recall_iou", r.segmentation.recall_iou()},
                                         {"gt", r.segmentation.gt}, {"detected", r.segmentation.detected}}},
                       {"id_stability", {{"planes", r.ids.planes}, {"stable", r.ids.stable}, {"frame_fraction", r.ids.fraction()}}},
-                      {"fuse_ms", r.fuse_ms}, {"raycast_ms", r.raycast_ms}, {"cues", nlohmann::json::array()}};
+                      {"fuse_ms", r.fuse_ms}, {"raycast_ms", r.raycast_ms}, {"filled_pixels", r.filled_pixels}, {"fill_ms", r.fill_ms}, {"cues", nlohmann::json::array()}};
   for (const auto& [g, h] : r.ids.unstable)
     for (const auto& [id, n] : h) j["id_stability"]["unstable"][std::to_string(g)][std::to_string(id)] = n;
   for (const auto& c : r.cues)
@@ -206,6 +207,9 @@ void run_eval(const EvalOptions& o) {
                 c.mean_ms.associate_ms, c.mean_ms.semantic_ms, c.mean_ms.verify_ms, c.mean_ms.total_ms);
   }
   std::printf("TSDF: fuse %.2f ms per frame, raycast %.2f ms per step\n", r.fuse_ms, r.raycast_ms);
+  if (r.filled_pixels > 0)
+    std::printf("depth filled on reflective masks (planes.fill): %lld pixels over the run, %.2f ms per frame\n",
+                (long long)r.filled_pixels, r.fill_ms);
   if (r.interrupted) signals.finish_interrupted(r.frames);
 }
 
@@ -250,6 +254,9 @@ void register_planes_command(CLI::App& app) {
       ->capture_default_str();
   e->add_flag("--no-exposure", ev->no_exposure,
               "fuse the frames' intensity into C_var as it is, without their exposure gain against the map")
+      ->capture_default_str();
+  e->add_flag("--no-fill", ev->no_fill,
+              "leave the depth the sensor lost on reflective masks unfilled (planes.fill; the first cue's masks fill it)")
       ->capture_default_str();
   e->add_flag("--no-fuse", ev->no_fuse, "no TSDF (C_var = 0): segmentation and global ids only");
   e->add_flag("--json", ev->json, "print JSON instead of a table");

@@ -11,6 +11,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <optional>
 #include <chrono>
 #include <optional>
 #include <set>
@@ -90,8 +91,8 @@ PlaneEvalReport run_plane_eval(const PlaneEvalOptions& options) {
 
   ObservedVariance observed(K, tp.truncation);
   PlaneEvalReport report;
-  double fuse_ms = 0, raycast_ms = 0;
-  size_t raycasts = 0;
+  double fuse_ms = 0, raycast_ms = 0, fill_ms = 0;
+  size_t raycasts = 0, fills = 0;
   for (size_t k = 0; k < frames; ++k) {
     io::Frame frame = dataset->load(k);
     if (!frame.T_wc_gt) throw std::runtime_error("planes eval: frame " + std::to_string(k) + " has no ground-truth pose");
@@ -101,6 +102,20 @@ PlaneEvalReport run_plane_eval(const PlaneEvalOptions& options) {
     DeviceImage<uint8_t> mask;
     std::vector<int32_t> remap;
     float exposure_gain = 1.0f;  // as the session estimates it (core/planes/exposure_gain.h)
+    // The depth the sensor lost on reflective masks, filled as the session does (planes.fill) with
+    // the first cue's masks, which every cue's segmentation of this frame then sees.
+    LabelImage labels;
+    const bool cue_masks = identify || identifiers[0].cue().masks_with_every_frame();
+    if (needs_labels && (identify || cue_masks)) labels = io::read_synth_labels(options.dataset, k);
+    std::optional<std::vector<SemanticMask>> masks;
+    if (options.params.fill.enabled && !identifiers[0].cue().every_plane_is_candidate() && cue_masks) {
+      IdentificationFrame f{&frame.depth, &frame.color, needs_labels ? &labels : nullptr, K, T_wc, int64_t(k)};
+      masks = identifiers[0].semantic_masks(f);
+      const auto t0 = std::chrono::steady_clock::now();
+      report.filled_pixels += fill_reflective_depth(frame.depth, *masks, K, options.params.fill_params()).pixels;
+      fill_ms += ms_since(t0);
+      ++fills;
+    }
     if (identify) {
       Image<float> cvar(K.width, K.height, 0.0f);
       if (volume) {
@@ -112,14 +127,13 @@ PlaneEvalReport run_plane_eval(const PlaneEvalOptions& options) {
         raycast_ms += ms_since(t0);
         ++raycasts;
       }
-      LabelImage labels;
-      if (needs_labels) labels = io::read_synth_labels(options.dataset, k);
       const LabelImage gt = io::read_synth_planes(options.dataset, k);
       const MaskImage gt_reflection = io::read_synth_reflection(options.dataset, k);
       observed.add(T_wc, frame.depth, frame.color, gt);
       IdentificationFrame f{&frame.depth, &frame.color, needs_labels ? &labels : nullptr, K, T_wc, int64_t(k),
                             options.fuse ? options.voxel_size : 0.0f};
       for (size_t c = 0; c < identifiers.size(); ++c) {
+        f.masks = c == 0 && masks ? &*masks : nullptr;
         IdentificationResult r = identifiers[c].identify(f, cvar);
         accumulate(time_sums[c], r.timings);
         for (const PlaneVerdict& v : r.planes)
@@ -161,6 +175,7 @@ PlaneEvalReport run_plane_eval(const PlaneEvalOptions& options) {
   report.frames = frames;
   report.fuse_ms = frames > 0 ? fuse_ms / double(frames) : 0;
   report.raycast_ms = raycasts > 0 ? raycast_ms / double(raycasts) : 0;
+  report.fill_ms = fills > 0 ? fill_ms / double(fills) : 0;
   report.global_planes = int(identifiers[0].table().live_ids().size());
   report.ids = scorers[0].id_stability(identifiers[0].table().remap_table());
   std::set<int> reflective_ids;

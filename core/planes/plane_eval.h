@@ -62,6 +62,8 @@ struct PlaneEvalReport {
   std::vector<Observed> observed;
   int global_planes = 0;            // live instances at the end
   double fuse_ms = 0, raycast_ms = 0;  // means per fused frame / per raycast
+  int64_t filled_pixels = 0;           // depth pixels filled on reflective masks (planes.fill), all frames
+  double fill_ms = 0;                  // mean per frame the fill ran on (the cue's masks excluded)
 };
 
 // Throws std::runtime_error naming what is missing (folder, planes.json, labels/ for "labels").

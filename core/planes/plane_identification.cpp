@@ -76,8 +76,17 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 }
 }  // namespace
 
+ReflectiveFillParams IdentificationParams::fill_params() const {
+  ReflectiveFillParams f = fill;
+  f.noise_a = segmentation.noise_a;
+  f.noise_b = segmentation.noise_b;
+  f.noise_z0 = segmentation.noise_z0;
+  return f;
+}
+
 void IdentificationParams::validate() const {
   segmentation.validate();
+  fill_params().validate();
   table.validate();
   vote.validate();
   if (!(variance_threshold >= 0)) throw std::invalid_argument("IdentificationParams: variance_threshold must be >= 0");
@@ -95,6 +104,15 @@ PlaneIdentifier::PlaneIdentifier(const IdentificationParams& params, std::unique
     : params_(params), cue_(std::move(cue)), table_(params.table), vote_(params.vote) {
   params_.validate();
   if (!cue_) throw std::invalid_argument("PlaneIdentifier: no semantic cue");
+}
+
+std::vector<SemanticMask> PlaneIdentifier::semantic_masks(const IdentificationFrame& frame) {
+  if (!frame.depth || !frame.color) throw std::invalid_argument("PlaneIdentifier::semantic_masks: depth and colour are required");
+  std::vector<SemanticMask> masks = cue_->segment({frame.color, frame.labels, frame.index});
+  for (const SemanticMask& m : masks)
+    if (!m.mask.same_size(*frame.depth))
+      throw std::runtime_error("semantic cue " + cue_->name() + ": mask size differs from the frame");
+  return masks;
 }
 
 IdentificationResult PlaneIdentifier::identify(const IdentificationFrame& frame, const Image<float>& color_variance) {
@@ -120,7 +138,9 @@ IdentificationResult PlaneIdentifier::identify(const IdentificationFrame& frame,
   out.timings.associate_ms = ms_since(t0);
 
   t0 = std::chrono::steady_clock::now();
-  const std::vector<SemanticMask> masks = cue_->segment({frame.color, frame.labels, frame.index});
+  std::vector<SemanticMask> own;
+  if (!frame.masks) own = semantic_masks(frame);
+  const std::vector<SemanticMask>& masks = frame.masks ? *frame.masks : own;
   for (const SemanticMask& m : masks)
     if (!m.mask.same_size(depth)) throw std::runtime_error("semantic cue " + cue_->name() + ": mask size differs from the frame");
   // Per global plane: pixels, pixels above δ_v, and overlap (all pixels, pixels above δ_v) with

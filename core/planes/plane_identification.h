@@ -11,6 +11,7 @@
 #include "core/common/image.h"
 #include "core/planes/global_plane_table.h"
 #include "core/planes/plane_segmentation.h"
+#include "core/planes/reflective_fill.h"
 #include "core/planes/reflective_vote.h"
 #include "core/planes/semantic_cue.h"
 
@@ -57,6 +58,10 @@ struct IdentificationParams {
   // colour before the Welford update, so that auto-exposure is not taken for view dependence
   // (core/planes/exposure_gain.h; the callers that fuse apply it). false = the paper's statistic.
   bool exposure_compensation = true;
+  // Depth the sensor lost on reflective masks, filled before identification and fusion
+  // (reflective_fill.h; the callers that fuse apply it). Its sensor noise is segmentation's.
+  ReflectiveFillParams fill;
+  ReflectiveFillParams fill_params() const;  // fill with segmentation's noise model
   void validate() const;             // throws std::invalid_argument
 };
 
@@ -68,6 +73,9 @@ struct IdentificationFrame {
   Eigen::Isometry3f T_wc = Eigen::Isometry3f::Identity();
   int64_t index = 0;                      // frame index
   float voxel_size = 0;                   // TSDF voxel behind C_var, metres (0 = no border erosion)
+  // The cue's masks of this frame when the caller has them already (semantic_masks(), e.g. for
+  // the depth fill); null: identify() asks the cue.
+  const std::vector<SemanticMask>* masks = nullptr;
 };
 
 struct PlaneVerdict {
@@ -102,6 +110,9 @@ class PlaneIdentifier {
 
   // One step. color_variance is C_var at the frame's pose (K's size; pixels without a surface 0).
   IdentificationResult identify(const IdentificationFrame& frame, const Image<float>& color_variance);
+  // The semantic cue's masks of a frame (colour, labels and index are read), checked against the
+  // depth's size. Throws std::runtime_error naming the cue when they differ.
+  std::vector<SemanticMask> semantic_masks(const IdentificationFrame& frame);
 
   const GlobalPlaneTable& table() const { return table_; }
   const ReflectiveVote& vote() const { return vote_; }

@@ -43,6 +43,9 @@ class SemanticCue {
   virtual std::string name() const = 0;  // "none" | "labels" | "remote"
   // True when there are no semantics: every plane is a candidate.
   virtual bool every_plane_is_candidate() const { return false; }
+  // True when masks come with every frame at no real cost (labels supplied with the frame), so a
+  // caller may ask for them on frames that do not identify (the depth fill, reflective_fill.h).
+  virtual bool masks_with_every_frame() const { return false; }
   // Instance masks of one frame (throws std::runtime_error naming the problem).
   virtual std::vector<SemanticMask> segment(const SemanticFrame& frame) = 0;
 };

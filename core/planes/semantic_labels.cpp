@@ -38,6 +38,7 @@ class LabelSemantics final : public SemanticCue {
     if (prompts_.empty()) throw std::invalid_argument("labels semantics: empty prompt list");
   }
   std::string name() const override { return "labels"; }
+  bool masks_with_every_frame() const override { return true; }
 
   std::vector<SemanticMask> segment(const SemanticFrame& frame) override {
     if (!frame.labels || frame.labels->empty())

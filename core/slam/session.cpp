@@ -10,6 +10,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <optional>
 #include <stdexcept>
 
 namespace rrg {
@@ -161,8 +162,9 @@ MappingContext Session::Impl::mapping_context() {
 }
 
 // Plane identification (§4.1.3) at the tracked pose, before this frame is fused.
-void Session::Impl::identify(const SessionFrame& frame, const Eigen::Isometry3f& T_wc, FrameReport& report,
-                             DeviceImage<int32_t>& plane_ids, DeviceImage<uint8_t>& mask) {
+void Session::Impl::identify(const SessionFrame& frame, const DepthImage& depth, const std::vector<SemanticMask>* masks,
+                             const Eigen::Isometry3f& T_wc, FrameReport& report, DeviceImage<int32_t>& plane_ids,
+                             DeviceImage<uint8_t>& mask) {
   const auto t0 = Clock::now();
   // C_var for the check; C_t and D_t only for the exposure gain (the identification's colour edges
   // are the input's).
@@ -170,13 +172,13 @@ void Session::Impl::identify(const SessionFrame& frame, const Eigen::Isometry3f&
   const RaycastResult rc = locked_raycast(K, T_wc, RaycastOutputs{.color = exposure, .reflection = true, .normals = false});
   const Image<float> cvar = rc.color_variance.to_host();
   if (exposure) {
-    const ExposureGain g = estimate_exposure_gain(frame.color, frame.depth, rc, config.tsdf.truncation);
+    const ExposureGain g = estimate_exposure_gain(frame.color, depth, rc, config.tsdf.truncation);
     report.exposure_gain = g.gain;
     spdlog::debug("frame {}: exposure gain {:.3f} over {} pixels{}", frame.index, g.gain, g.pixels,
                   g.estimated ? "" : " (too few: 1)");
   }
-  IdentificationFrame f{&frame.depth, &frame.color, frame.labels ? &*frame.labels : nullptr, K, T_wc, frame.index,
-                        config.tsdf.voxel_size};
+  IdentificationFrame f{&depth, &frame.color, frame.labels ? &*frame.labels : nullptr, K, T_wc, frame.index,
+                        config.tsdf.voxel_size, masks};
   if (identifier.cue().name() == "labels" && !frame.labels) f.labels = nullptr;
   IdentificationResult r = identifier.identify(f, cvar);
   plane_ids = DeviceImage<int32_t>::from_host(r.global_map, config.device);
@@ -194,7 +196,7 @@ void Session::Impl::identify(const SessionFrame& frame, const Eigen::Isometry3f&
     global_planes = identifier.table().live_ids().size();
   }
   report.identified = true;
-  report.times.identify = ms_since(t0);
+  report.times.identify += ms_since(t0);
 }
 
 // Hands the fused frames to the mapper and runs a step: inline (sync) or on the mapping thread.
@@ -264,7 +266,30 @@ FrameReport Session::process(const SessionFrame& frame) {
   FrameReport report;
   report.index = frame.index;
   report.timestamp = frame.timestamp;
-  const auto depth = DeviceImage<float>::from_host(frame.depth, s.config.device);
+
+  // 0. depth the sensor lost on reflective masks, filled from the plane around them before
+  // tracking, identification and fusion (planes.fill, core/planes/reflective_fill.h): on the
+  // frames whose masks the cue gives anyway (identification frames) or at no cost (labels).
+  const bool identify_due = s.fused % s.config.plane_period == 0;
+  std::optional<std::vector<SemanticMask>> masks;
+  DepthImage filled;
+  const DepthImage* D_k = &frame.depth;
+  const SemanticCue& cue = s.identifier.cue();
+  if (s.config.planes.fill.enabled && !cue.every_plane_is_candidate() &&
+      (identify_due || (cue.masks_with_every_frame() && frame.labels))) {
+    const auto tf = Clock::now();
+    masks = s.identifier.semantic_masks({&frame.depth, &frame.color, frame.labels ? &*frame.labels : nullptr, s.K,
+                                         Eigen::Isometry3f::Identity(), frame.index, s.config.tsdf.voxel_size});
+    filled = frame.depth;
+    const ReflectiveFillResult fr = fill_reflective_depth(filled, *masks, s.K, s.config.planes.fill_params());
+    report.filled_pixels = fr.pixels;
+    if (fr.pixels > 0) D_k = &filled;
+    for (const ReflectiveFillMask& m : fr.masks)
+      spdlog::debug("frame {}: {} mask, {} px, {} missing: {}", frame.index, m.label, m.pixels, m.missing,
+                    m.skipped.empty() ? fmt::format("{} px filled", m.filled) : m.skipped);
+    report.times.identify = ms_since(tf);
+  }
+  const auto depth = DeviceImage<float>::from_host(*D_k, s.config.device);
   const auto color = DeviceImage<Color>::from_host(frame.color, s.config.device);
 
   // 1. tracking (§4.1.2), or the given pose. Mapping keyframes are the tracker's keyframes (the
@@ -282,7 +307,7 @@ FrameReport Session::process(const SessionFrame& frame) {
       s.model.model_at(s.T_last);
       report.times.raycast = ms_since(tr);
     }
-    const TrackResult r = s.tracker.track({size_t(frame.index), &frame.color, &frame.depth, &depth}, s.model, s.masks.get());
+    const TrackResult r = s.tracker.track({size_t(frame.index), &frame.color, D_k, &depth}, s.model, s.masks.get());
     report.T_wc = r.T_wc;
     report.state = r.state;
     report.note = r.note;
@@ -296,8 +321,8 @@ FrameReport Session::process(const SessionFrame& frame) {
   if (report.state != TrackingState::Lost) {
     DeviceImage<int32_t> plane_ids;
     DeviceImage<uint8_t> mask;
-    const bool identify = s.fused % s.config.plane_period == 0;
-    if (identify) s.identify(frame, report.T_wc, report, plane_ids, mask);
+    const bool identify = identify_due;
+    if (identify) s.identify(frame, *D_k, masks ? &*masks : nullptr, report.T_wc, report, plane_ids, mask);
     const auto tf = Clock::now();
     {
       std::unique_lock lock(s.volume_mutex);  // the one writer
@@ -313,7 +338,7 @@ FrameReport Session::process(const SessionFrame& frame) {
     report.fused = true;
     ++s.fused;
     s.map_version.fetch_add(1);
-    s.pending.push_back(MappingFrame{frame.index, report.T_wc, frame.color, frame.depth});
+    s.pending.push_back(MappingFrame{frame.index, report.T_wc, frame.color, *D_k});
     s.pending_keyframe.push_back(keyframe);
     // 4. a mapping step every N_o fused frames (§4.2)
     if (s.fused % s.config.mapping_period == 0) s.schedule_mapping(report);

@@ -51,7 +51,8 @@ struct StageTimes {
   double icp = 0;
   double orb = 0;          // ORB + motion-only BA (+ the tracking-mask render)
   double fuse = 0;
-  double identify = 0;     // plane identification incl. its C_var raycast
+  double identify = 0;     // plane identification incl. its C_var raycast, the cue's masks and the
+                           // reflective depth fill (planes.fill; on frames that do not identify too)
   double mapping = 0;      // a mapping step run inline (sync) or waited for
   double total = 0;        // the whole process() call
 };
@@ -64,6 +65,7 @@ struct FrameReport {
   bool fused = false;              // false when lost (the frame is not fused)
   bool identified = false;         // plane identification ran on this frame
   float exposure_gain = 1.0f;      // its exposure against the map, fused into C_var (1: none estimated)
+  int64_t filled_pixels = 0;       // depth pixels filled on reflective masks (planes.fill)
   bool mapping_started = false;    // a mapping step was started (async) or run (sync) after it
   uint64_t map_version = 0;        // after this frame
   std::string note;                // tracking note

@@ -209,6 +209,12 @@ std::vector<ConfigField> config_fields(SessionConfig& c) {
       "pixels as near to a colour edge of the input (step > 2 sqrt(delta_v)) are left out too");
   t.b("planes.exposure_compensation", c.planes.exposure_compensation,
       "the variance statistic takes each identification frame's intensity over its exposure gain against the map");
+  t.b("planes.fill.enabled", c.planes.fill.enabled,
+      "fill the depth the sensor lost on reflective masks from the plane around them (labels / remote cues)");
+  t.f("planes.fill.min_missing", c.planes.fill.min_missing,
+      "fill a mask when this share of its pixels has no depth or depth behind that plane");
+  t.f("planes.fill.min_inlier_ratio", c.planes.fill.min_inlier_ratio, "share of the ring around the mask on one plane");
+  t.i("planes.fill.min_sides", c.planes.fill.min_sides, "sides of the mask's bounding box that plane must be seen on");
   t.i("planes.vote.windows", c.planes.vote.windows, "vote history, windows");
   t.i("planes.vote.min_reflective", c.planes.vote.min_reflective, "windows needed to accept");
   t.f("planes.segmentation.noise_a", c.planes.segmentation.noise_a, "sensor noise σ_n = a + b (z − z0)², a in metres");

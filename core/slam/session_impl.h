@@ -67,8 +67,11 @@ struct Session::Impl {
   // process() stages
   // Fills the fusion's reflection observation of this frame: I_k^g, the reflection mask and the
   // exposure gain (report.exposure_gain).
-  void identify(const SessionFrame& frame, const Eigen::Isometry3f& T_wc, FrameReport& report,
-                DeviceImage<int32_t>& plane_ids, DeviceImage<uint8_t>& mask);
+  // depth: D_k as tracked and fused (after the reflective fill); masks: the cue's masks of this
+  // frame when the fill asked for them already (else identification asks the cue).
+  void identify(const SessionFrame& frame, const DepthImage& depth, const std::vector<SemanticMask>* masks,
+                const Eigen::Isometry3f& T_wc, FrameReport& report, DeviceImage<int32_t>& plane_ids,
+                DeviceImage<uint8_t>& mask);
   void schedule_mapping(FrameReport& report);
   MappingContext mapping_context();
   RaycastResult locked_raycast(const Intrinsics& K, const Eigen::Isometry3f& T_wc,

@@ -1,0 +1,233 @@
+#include "core/planes/reflective_fill.h"
+
+#include "core/planes/plane_fit.h"
+
+#include <Eigen/Geometry>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+
+namespace rrg {
+
+float ReflectiveFillParams::tolerance(float z) const {
+  const float sigma = noise_a + noise_b * (z - noise_z0) * (z - noise_z0);
+  return std::max(min_tolerance, inlier_sigmas * sigma);
+}
+
+void ReflectiveFillParams::validate() const {
+  const auto fail = [](const char* field, const char* why) {
+    throw std::invalid_argument(fmt::format("planes.fill.{} {}", field, why));
+  };
+  if (!(min_missing >= 0.0f && min_missing <= 1.0f)) fail("min_missing", "must be in [0, 1]");
+  if (min_mask_pixels < 1) fail("min_mask_pixels", "must be >= 1");
+  if (!(ring_fraction >= 0.0f && ring_fraction <= 1.0f)) fail("ring_fraction", "must be in [0, 1]");
+  if (min_ring_px < 1) fail("min_ring_px", "must be >= 1");
+  if (min_ring_points < 3) fail("min_ring_points", "must be >= 3");
+  if (!(inlier_sigmas > 0.0f) || !std::isfinite(inlier_sigmas)) fail("inlier_sigmas", "must be > 0");
+  if (!(min_tolerance > 0.0f) || !std::isfinite(min_tolerance)) fail("min_tolerance", "must be > 0");
+  if (!(noise_a >= 0.0f && noise_b >= 0.0f) || !std::isfinite(noise_a + noise_b + noise_z0))
+    fail("noise_a/noise_b", "must be finite and >= 0");
+  if (!(min_inlier_ratio > 0.0f && min_inlier_ratio <= 1.0f)) fail("min_inlier_ratio", "must be in (0, 1]");
+  if (min_sides < 1 || min_sides > 4) fail("min_sides", "must be 1..4");
+  if (!(min_side_share >= 0.0f && min_side_share <= 0.25f)) fail("min_side_share", "must be in [0, 0.25]");
+  if (!(max_ray_angle_deg > 0.0f && max_ray_angle_deg < 90.0f)) fail("max_ray_angle_deg", "must be in (0, 90)");
+  if (ransac_iterations < 1) fail("ransac_iterations", "must be >= 1");
+  if (!(max_depth > 0.0f) || !std::isfinite(max_depth)) fail("max_depth", "must be > 0");
+}
+
+namespace {
+
+struct Box {
+  int x0, y0, x1, y1;  // inclusive
+};
+
+// Pixels within Chebyshev distance r of the mask, restricted to the mask's box grown by r
+// (separable: a row pass, then a column pass, each a running count over a 2r + 1 window).
+MaskImage dilate(const MaskImage& mask, const Box& b, int r) {
+  const int w = mask.width(), h = mask.height();
+  const int x0 = std::max(0, b.x0 - r), x1 = std::min(w - 1, b.x1 + r);
+  const int y0 = std::max(0, b.y0 - r), y1 = std::min(h - 1, b.y1 + r);
+  MaskImage rows(w, h, 0), out(w, h, 0);
+  for (int y = b.y0; y <= b.y1; ++y) {
+    int count = 0;  // mask pixels in [x − r, x + r]
+    for (int x = x0 - r; x <= x1; ++x) {
+      const int in = x + r, gone = x - r - 1;
+      if (in >= 0 && in < w && mask(in, y)) ++count;
+      if (gone >= 0 && gone < w && mask(gone, y)) --count;
+      if (x >= x0) rows(x, y) = count > 0;
+    }
+  }
+  for (int x = x0; x <= x1; ++x) {
+    int count = 0;
+    for (int y = y0 - r; y <= y1; ++y) {
+      const int in = y + r, gone = y - r - 1;
+      if (in >= 0 && in < h && rows(x, in)) ++count;
+      if (gone >= 0 && gone < h && rows(x, gone)) --count;
+      if (y >= y0) out(x, y) = count > 0;
+    }
+  }
+  return out;
+}
+
+struct RingPoint {
+  Eigen::Vector3f p;
+  int u, v;
+  float tol;
+};
+
+// RANSAC over (a stride of) the ring points, then a least-squares refit to the inliers.
+bool fit_ring_plane(const std::vector<RingPoint>& ring, const ReflectiveFillParams& params, Plane& plane) {
+  constexpr size_t kMaxScored = 1024;  // a stride of the ring scores the hypotheses; the refit takes all
+  const size_t stride = std::max<size_t>(1, ring.size() / kMaxScored);
+  std::mt19937 rng(0x5eedu);  // deterministic: the same frame gives the same fill
+  std::uniform_int_distribution<size_t> pick(0, ring.size() - 1);
+  Plane best;
+  size_t best_count = 0;
+  for (int it = 0; it < params.ransac_iterations; ++it) {
+    const Eigen::Vector3f &a = ring[pick(rng)].p, &b = ring[pick(rng)].p, &c = ring[pick(rng)].p;
+    Eigen::Vector3f n = (b - a).cross(c - a);
+    const float len = n.norm();
+    if (!(len > 1e-9f)) continue;
+    n /= len;
+    const Plane cand{n, -n.dot(a)};
+    size_t count = 0;
+    for (size_t i = 0; i < ring.size(); i += stride)
+      if (std::abs(cand.signed_distance(ring[i].p)) < ring[i].tol) ++count;
+    if (count > best_count) {
+      best_count = count;
+      best = cand;
+    }
+  }
+  if (best_count < 3) return false;
+  PlaneMoments m;
+  for (const RingPoint& r : ring)
+    if (std::abs(best.signed_distance(r.p)) < r.tol) m.add(r.p);
+  const PlaneFit fit = fit_plane(m);  // normal towards the camera centre: d > 0
+  if (!fit.valid) return false;
+  plane = fit.plane;
+  return true;
+}
+
+}  // namespace
+
+ReflectiveFillResult fill_reflective_depth(DepthImage& depth, std::span<const SemanticMask> masks, const Intrinsics& K,
+                                           const ReflectiveFillParams& params) {
+  params.validate();
+  const int w = depth.width(), h = depth.height();
+  if (K.width != w || K.height != h)
+    throw std::invalid_argument(fmt::format("fill_reflective_depth: intrinsics {}x{} but depth {}x{}", K.width, K.height, w, h));
+  for (const SemanticMask& m : masks)
+    if (!m.mask.same_size(depth))
+      throw std::invalid_argument(fmt::format("fill_reflective_depth: mask '{}' is {}x{}, depth {}x{}", m.label,
+                                              m.mask.width(), m.mask.height(), w, h));
+  ReflectiveFillResult out;
+  out.filled = MaskImage(w, h, 0);
+  const float cos_max = std::cos(params.max_ray_angle_deg * float(M_PI) / 180.0f);
+  const auto ray = [&](int u, int v) { return Eigen::Vector3f((float(u) - K.cx) / K.fx, (float(v) - K.cy) / K.fy, 1.0f); };
+  for (const SemanticMask& sm : masks) {
+    if (!sm.reflective) continue;
+    ReflectiveFillMask rec;
+    rec.label = sm.label;
+    Box box{w, h, -1, -1};
+    for (int v = 0; v < h; ++v)
+      for (int u = 0; u < w; ++u)
+        if (sm.mask(u, v)) {
+          ++rec.pixels;
+          box = {std::min(box.x0, u), std::min(box.y0, v), std::max(box.x1, u), std::max(box.y1, v)};
+        }
+    const auto done = [&](std::string why) {
+      rec.skipped = std::move(why);
+      out.masks.push_back(std::move(rec));
+    };
+    if (rec.pixels < params.min_mask_pixels) {
+      done("mask too small");
+      continue;
+    }
+    // The ring and its valid depth, back-projected.
+    const float diagonal = std::hypot(float(box.x1 - box.x0 + 1), float(box.y1 - box.y0 + 1));
+    const int r = std::max(params.min_ring_px, int(std::lround(params.ring_fraction * diagonal)));
+    const MaskImage grown = dilate(sm.mask, box, r);
+    std::vector<RingPoint> ring;
+    for (int v = std::max(0, box.y0 - r); v <= std::min(h - 1, box.y1 + r); ++v)
+      for (int u = std::max(0, box.x0 - r); u <= std::min(w - 1, box.x1 + r); ++u) {
+        const float z = depth(u, v);
+        if (!grown(u, v) || sm.mask(u, v) || !(z > 0.0f) || !std::isfinite(z)) continue;
+        ring.push_back({z * ray(u, v), u, v, params.tolerance(z)});
+      }
+    rec.ring_points = int64_t(ring.size());
+    if (rec.ring_points < params.min_ring_points) {
+      done("too little depth around the mask");
+      continue;
+    }
+    if (!fit_ring_plane(ring, params, rec.plane)) {
+      done("no plane around the mask");
+      continue;
+    }
+    rec.fitted = true;
+    // Inliers, and the sides of the box they lie on (the one each is farthest outside of).
+    std::array<int64_t, 4> side{0, 0, 0, 0};
+    int64_t inliers = 0;
+    for (const RingPoint& p : ring) {
+      if (!(std::abs(rec.plane.signed_distance(p.p)) < p.tol)) continue;
+      ++inliers;
+      const std::array<int, 4> out_by{box.x0 - p.u, p.u - box.x1, box.y0 - p.v, p.v - box.y1};
+      ++side[size_t(std::max_element(out_by.begin(), out_by.end()) - out_by.begin())];
+    }
+    rec.inlier_ratio = float(inliers) / float(ring.size());
+    for (const int64_t s : side) rec.sides += s > 0 && float(s) >= params.min_side_share * float(inliers);
+    // Per mask pixel: where its ray meets the plane (0 when behind the camera, too oblique or too far).
+    const auto plane_depth = [&](int u, int v) {
+      const Eigen::Vector3f d = ray(u, v);
+      const float nd = rec.plane.n.dot(d);  // < 0 when the ray meets the plane's camera-facing side
+      if (!(-nd >= cos_max * d.norm())) return 0.0f;
+      const float z = -rec.plane.d / nd;
+      return z > 0.0f && z <= params.max_depth ? z : 0.0f;
+    };
+    const auto missing = [&](float d, float z) {  // no depth, or depth behind the plane
+      return !(d > 0.0f) || !std::isfinite(d) || (z > 0.0f && d > z + params.tolerance(z));
+    };
+    for (int v = box.y0; v <= box.y1; ++v)
+      for (int u = box.x0; u <= box.x1; ++u)
+        if (sm.mask(u, v)) rec.missing += missing(depth(u, v), plane_depth(u, v));
+    if (rec.inlier_ratio < params.min_inlier_ratio) {
+      done(fmt::format("the depth around the mask is not planar ({:.2f} on the plane)", rec.inlier_ratio));
+      continue;
+    }
+    if (rec.sides < params.min_sides) {
+      done(fmt::format("the plane around the mask is seen on {} side(s)", rec.sides));
+      continue;
+    }
+    if (float(rec.missing) < params.min_missing * float(rec.pixels)) {
+      done("the sensor kept the surface");
+      continue;
+    }
+    for (int v = box.y0; v <= box.y1; ++v)
+      for (int u = box.x0; u <= box.x1; ++u) {
+        if (!sm.mask(u, v)) continue;
+        const float z = plane_depth(u, v);
+        if (z > 0.0f && missing(depth(u, v), z)) {
+          depth(u, v) = z;
+          out.filled(u, v) = 1;
+          ++rec.filled;
+        }
+      }
+    out.pixels += rec.filled;
+    if (rec.filled == 0) rec.skipped = "no pixel faces the plane";
+    out.masks.push_back(std::move(rec));
+  }
+  return out;
+}
+
+void copy_filled_depth(const DepthImage& from, const MaskImage& filled, DepthImage& to) {
+  if (!from.same_size(filled) || !from.same_size(to))
+    throw std::invalid_argument(fmt::format("copy_filled_depth: sizes {}x{}, {}x{} and {}x{} differ", from.width(),
+                                            from.height(), filled.width(), filled.height(), to.width(), to.height()));
+  for (size_t i = 0; i < from.size(); ++i)
+    if (filled[i]) to[i] = from[i];
+}
+
+}  // namespace rrg

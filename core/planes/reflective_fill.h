@@ -1,0 +1,82 @@
+#pragma once
+// Depth that the sensor lost on a reflective surface, restored from the semantic cue and the
+// surface around it. Structured-light and time-of-flight sensors return no depth on a mirror or
+// on glass, or the depth of the mirrored scene behind it; the TSDF then has a hole there (or the
+// virtual room), segmentation finds no plane and §4.1.3 never gets to verify one. Before
+// identification and fusion, each reflective mask of the cue whose pixels have largely no depth,
+// or depth behind the surface around it, is filled with the plane that the valid depth in a ring
+// just outside the mask lies on (the wall or frame a mirror hangs in), provided that ring is
+// planar and surrounds the mask. Pixels in front of that plane (an occluder, the mirror's own
+// frame) keep their depth. A departure from the paper, which assumes depth on its planes
+// (docs/planes.md "Mirrors without depth").
+#include "core/common/camera.h"
+#include "core/common/image.h"
+#include "core/planes/plane_types.h"
+#include "core/planes/semantic_cue.h"
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace rrg {
+
+struct ReflectiveFillParams {
+  bool enabled = true;
+  // A mask is filled when at least this share of its pixels has no depth or depth behind the ring's
+  // plane: a mirror the sensor saw has next to none (edge dropouts), a lost one most of its area.
+  float min_missing = 0.25f;
+  int64_t min_mask_pixels = 64;  // smaller masks are left alone
+  // Ring: the pixels within max(min_ring_px, ring_fraction · mask bbox diagonal) outside the mask.
+  float ring_fraction = 0.04f;
+  int min_ring_px = 3;
+  int64_t min_ring_points = 48;  // valid ring pixels needed for a fit
+  // A ring point is on the plane within max(min_tolerance, inlier_sigmas σ_n(z)), σ_n the sensor's
+  // axial noise a + b (z − z0)² (Kinect v1, Nguyen et al. 2012, as plane segmentation uses). The
+  // same tolerance decides "behind the plane".
+  float inlier_sigmas = 3.0f;
+  float min_tolerance = 0.01f;
+  float noise_a = 0.0012f, noise_b = 0.0019f, noise_z0 = 0.4f;
+  float min_inlier_ratio = 0.6f;  // of the valid ring points
+  // The inliers must surround the mask: each of at least min_sides of the four sides of its
+  // bounding box holds min_side_share of them (a plane seen on one side only is extrapolated).
+  int min_sides = 3;
+  float min_side_share = 0.05f;
+  float max_ray_angle_deg = 80.0f;  // no fill where a ray meets the plane more obliquely
+  int ransac_iterations = 128;      // deterministic (fixed seed)
+  float max_depth = 10.0f;          // filled depths beyond this are left out, metres
+
+  float tolerance(float z) const;   // max(min_tolerance, inlier_sigmas σ_n(z))
+  void validate() const;            // throws std::invalid_argument naming the field
+};
+
+// What happened to one reflective mask.
+struct ReflectiveFillMask {
+  std::string label;
+  int64_t pixels = 0;         // mask pixels
+  int64_t missing = 0;        // without depth or behind the plane (0 when no plane was fitted)
+  int64_t filled = 0;         // pixels written
+  int64_t ring_points = 0;    // valid ring pixels
+  float inlier_ratio = 0.0f;  // of the ring points, on the plane
+  int sides = 0;              // sides of the mask's bounding box the inliers cover
+  Plane plane;                // camera frame, facing the camera (d > 0), when fitted
+  bool fitted = false;
+  std::string skipped;        // why nothing was written ("" when filled)
+};
+
+struct ReflectiveFillResult {
+  std::vector<ReflectiveFillMask> masks;  // one per reflective mask, in the cue's order
+  MaskImage filled;                       // 1 where depth was written; the frame's size
+  int64_t pixels = 0;                     // pixels written in all
+};
+
+// Fills `depth` (metres, 0 = invalid) in place from the reflective masks among `masks`. Throws
+// std::invalid_argument when a mask's size or K's differs from the depth's, or for bad params.
+ReflectiveFillResult fill_reflective_depth(DepthImage& depth, std::span<const SemanticMask> masks, const Intrinsics& K,
+                                           const ReflectiveFillParams& params);
+
+// Writes the filled pixels of `from` into `to` (the same fill applied to another copy of the
+// frame's depth, e.g. the tracker's filtered one). Throws std::invalid_argument on size mismatch.
+void copy_filled_depth(const DepthImage& from, const MaskImage& filled, DepthImage& to);
+
+}  // namespace rrg

@@ -1,0 +1,188 @@
+// fill_reflective_depth: a tilted wall with a mirror whose depth the sensor lost (or saw through),
+// against the plane's analytic depth; surroundings that are not one plane, or seen on too few
+// sides, leave the frame as it is.
+#include "core/planes/reflective_fill.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace rrg {
+namespace {
+
+const Intrinsics kK{140.0f, 140.0f, 79.5f, 59.5f, 160, 120};
+
+// The wall n·p + d = 0, facing the camera (d > 0), through (0, 0, 2.5).
+Plane wall() {
+  const Eigen::Vector3f n = Eigen::Vector3f(0.2f, -0.1f, -1.0f).normalized();
+  return {n, -n.dot(Eigen::Vector3f(0.0f, 0.0f, 2.5f))};
+}
+
+float wall_depth(int u, int v) {
+  const Plane p = wall();
+  const Eigen::Vector3f r((float(u) - kK.cx) / kK.fx, (float(v) - kK.cy) / kK.fy, 1.0f);
+  return -p.d / p.n.dot(r);
+}
+
+DepthImage wall_image() {
+  DepthImage d(kK.width, kK.height);
+  for (int v = 0; v < kK.height; ++v)
+    for (int u = 0; u < kK.width; ++u) d(u, v) = wall_depth(u, v);
+  return d;
+}
+
+SemanticMask rect_mask(int x0, int y0, int x1, int y1, bool reflective = true, const char* label = "mirror") {
+  SemanticMask m;
+  m.mask = MaskImage(kK.width, kK.height, 0);
+  for (int v = y0; v <= y1; ++v)
+    for (int u = x0; u <= x1; ++u) m.mask(u, v) = 1;
+  m.label = label;
+  m.reflective = reflective;
+  return m;
+}
+
+TEST(ReflectiveFill, ALostMirrorTakesTheDepthOfTheWallAroundIt) {
+  DepthImage depth = wall_image();
+  const SemanticMask mirror = rect_mask(50, 30, 110, 90);
+  for (int v = 30; v <= 90; ++v)
+    for (int u = 50; u <= 110; ++u) depth(u, v) = 0.0f;  // the glass: no depth
+  const DepthImage before = depth;
+  const ReflectiveFillResult r = fill_reflective_depth(depth, std::span(&mirror, 1), kK, ReflectiveFillParams{});
+  ASSERT_EQ(r.masks.size(), 1u);
+  EXPECT_EQ(r.masks[0].skipped, "");
+  EXPECT_EQ(r.masks[0].pixels, 61 * 61);
+  EXPECT_EQ(r.masks[0].missing, 61 * 61);
+  EXPECT_EQ(r.masks[0].filled, 61 * 61);
+  EXPECT_EQ(r.pixels, 61 * 61);
+  EXPECT_EQ(r.masks[0].sides, 4);
+  EXPECT_NEAR(r.masks[0].inlier_ratio, 1.0f, 1e-6f);
+  EXPECT_GT(r.masks[0].plane.d, 0.0f) << "the plane faces the camera";
+  for (int v = 0; v < kK.height; ++v)
+    for (int u = 0; u < kK.width; ++u) {
+      const bool inside = mirror.mask(u, v) != 0;
+      EXPECT_EQ(r.filled(u, v), inside ? 1 : 0);
+      if (inside) EXPECT_NEAR(depth(u, v), wall_depth(u, v), 1e-4f) << u << "," << v;
+      else EXPECT_EQ(depth(u, v), before(u, v)) << "outside the mask nothing changes";
+    }
+}
+
+TEST(ReflectiveFill, DepthSeenThroughTheMirrorIsReplacedAndOccludersAreKept) {
+  DepthImage depth = wall_image();
+  const SemanticMask mirror = rect_mask(40, 20, 120, 100);
+  for (int v = 20; v <= 100; ++v)
+    for (int u = 40; u <= 120; ++u) depth(u, v) = wall_depth(u, v) + 1.5f;  // the mirrored room behind the glass
+  for (int v = 50; v <= 70; ++v)
+    for (int u = 60; u <= 80; ++u) depth(u, v) = 1.2f;  // a vase in front of the mirror
+  // Sensor noise on everything: 3 mm, below the 1 cm tolerance at 2.5 m.
+  std::mt19937 rng(7);
+  std::normal_distribution<float> noise(0.0f, 0.003f);
+  for (float& z : depth.pixels()) z += noise(rng);
+  const ReflectiveFillResult r = fill_reflective_depth(depth, std::span(&mirror, 1), kK, ReflectiveFillParams{});
+  ASSERT_EQ(r.masks.size(), 1u);
+  EXPECT_EQ(r.masks[0].skipped, "");
+  EXPECT_EQ(r.masks[0].filled, 81 * 81 - 21 * 21);
+  for (int v = 20; v <= 100; ++v)
+    for (int u = 40; u <= 120; ++u) {
+      const bool vase = u >= 60 && u <= 80 && v >= 50 && v <= 70;
+      if (vase) EXPECT_NEAR(depth(u, v), 1.2f, 0.02f) << "an occluder in front of the plane keeps its depth";
+      else EXPECT_NEAR(depth(u, v), wall_depth(u, v), 0.003f) << u << "," << v;
+    }
+}
+
+TEST(ReflectiveFill, SurroundingsThatAreNotOnePlaneLeaveTheHole) {
+  DepthImage depth = wall_image();
+  for (int v = 0; v < kK.height; ++v)
+    for (int u = 0; u < kK.width; ++u) depth(u, v) += 0.3f * std::sin(float(u) * 0.7f) * std::cos(float(v) * 0.9f);
+  const SemanticMask mirror = rect_mask(50, 30, 110, 90);
+  for (int v = 30; v <= 90; ++v)
+    for (int u = 50; u <= 110; ++u) depth(u, v) = 0.0f;
+  const DepthImage before = depth;
+  const ReflectiveFillResult r = fill_reflective_depth(depth, std::span(&mirror, 1), kK, ReflectiveFillParams{});
+  ASSERT_EQ(r.masks.size(), 1u);
+  EXPECT_EQ(r.masks[0].filled, 0);
+  EXPECT_NE(r.masks[0].skipped.find("not planar"), std::string::npos) << r.masks[0].skipped;
+  EXPECT_EQ(r.pixels, 0);
+  for (size_t i = 0; i < depth.size(); ++i) ASSERT_EQ(depth[i], before[i]);
+}
+
+TEST(ReflectiveFill, APlaneSeenOnTwoSidesIsNotExtrapolated) {
+  DepthImage depth = wall_image();
+  const SemanticMask mirror = rect_mask(0, 0, 70, 60);  // in the image's top-left corner
+  for (int v = 0; v <= 60; ++v)
+    for (int u = 0; u <= 70; ++u) depth(u, v) = 0.0f;
+  const ReflectiveFillResult r = fill_reflective_depth(depth, std::span(&mirror, 1), kK, ReflectiveFillParams{});
+  ASSERT_EQ(r.masks.size(), 1u);
+  EXPECT_EQ(r.masks[0].sides, 2);
+  EXPECT_EQ(r.masks[0].filled, 0);
+  EXPECT_EQ(depth(10, 10), 0.0f);
+  // Two sides suffice when asked for.
+  ReflectiveFillParams two;
+  two.min_sides = 2;
+  const ReflectiveFillResult r2 = fill_reflective_depth(depth, std::span(&mirror, 1), kK, two);
+  EXPECT_EQ(r2.masks[0].filled, 71 * 61);
+  EXPECT_NEAR(depth(10, 10), wall_depth(10, 10), 1e-4f);
+}
+
+TEST(ReflectiveFill, ASurfaceTheSensorKeptIsLeftAlone) {
+  DepthImage depth = wall_image();
+  const SemanticMask mirror = rect_mask(50, 30, 110, 90);
+  for (int v = 30; v <= 90; v += 4)  // edge dropouts: 1 in 16 pixels
+    for (int u = 50; u <= 110; u += 4) depth(u, v) = 0.0f;
+  const DepthImage before = depth;
+  const ReflectiveFillResult r = fill_reflective_depth(depth, std::span(&mirror, 1), kK, ReflectiveFillParams{});
+  ASSERT_EQ(r.masks.size(), 1u);
+  EXPECT_EQ(r.masks[0].skipped, "the sensor kept the surface");
+  EXPECT_EQ(r.masks[0].missing, 16 * 16);
+  EXPECT_EQ(r.masks[0].filled, 0);
+  for (size_t i = 0; i < depth.size(); ++i) ASSERT_EQ(depth[i], before[i]);
+}
+
+TEST(ReflectiveFill, OnlyReflectiveMasksAreConsidered) {
+  DepthImage depth = wall_image();
+  const SemanticMask sofa = rect_mask(50, 30, 110, 90, false, "sofa");
+  for (int v = 30; v <= 90; ++v)
+    for (int u = 50; u <= 110; ++u) depth(u, v) = 0.0f;
+  const ReflectiveFillResult r = fill_reflective_depth(depth, std::span(&sofa, 1), kK, ReflectiveFillParams{});
+  EXPECT_TRUE(r.masks.empty());
+  EXPECT_EQ(depth(80, 60), 0.0f);
+}
+
+TEST(ReflectiveFill, BadInputIsRejected) {
+  DepthImage depth = wall_image();
+  SemanticMask small;
+  small.mask = MaskImage(10, 10, 1);
+  small.label = "mirror";
+  small.reflective = true;
+  EXPECT_THROW(fill_reflective_depth(depth, std::span(&small, 1), kK, ReflectiveFillParams{}), std::invalid_argument);
+  Intrinsics other = kK;
+  other.width = 80;
+  EXPECT_THROW(fill_reflective_depth(depth, {}, other, ReflectiveFillParams{}), std::invalid_argument);
+  ReflectiveFillParams bad;
+  bad.min_sides = 5;
+  try {
+    fill_reflective_depth(depth, {}, kK, bad);
+    FAIL() << "min_sides 5 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("min_sides"), std::string::npos) << e.what();
+  }
+  MaskImage filled(4, 4, 0);
+  EXPECT_THROW(copy_filled_depth(depth, filled, depth), std::invalid_argument);
+}
+
+TEST(ReflectiveFill, TheSameFillCopiesIntoAnotherDepth) {
+  DepthImage depth = wall_image();
+  const SemanticMask mirror = rect_mask(50, 30, 110, 90);
+  for (int v = 30; v <= 90; ++v)
+    for (int u = 50; u <= 110; ++u) depth(u, v) = 0.0f;
+  DepthImage filtered = depth;
+  filtered(0, 0) = 9.0f;  // differs outside the fill
+  const ReflectiveFillResult r = fill_reflective_depth(depth, std::span(&mirror, 1), kK, ReflectiveFillParams{});
+  copy_filled_depth(depth, r.filled, filtered);
+  EXPECT_EQ(filtered(0, 0), 9.0f);
+  EXPECT_EQ(filtered(80, 60), depth(80, 60));
+  EXPECT_GT(filtered(80, 60), 0.0f);
+}
+
+}  // namespace
+}  // namespace rrg
