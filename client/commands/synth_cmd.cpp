@@ -78,7 +78,7 @@ void register_synth_command(CLI::App& app) {
   cmd->add_option("--novel", p.novel, "held-out novel views written to OUT/novel")->capture_default_str();
   cmd->add_flag("--noise", p.noise, "Kinect-like depth noise and edge dropouts (deterministic)");
   cmd->add_flag("--exposure", p.exposure, "auto-exposure: the frames' colour drifts by a gain within [1/1.35, 1.35] (deterministic)");
-  cmd->add_option("--mirror-depth", opt->mirror_depth, "depth on mirrors (F0 > 0.5): surface | invalid")
+  cmd->add_option("--mirror-depth", opt->mirror_depth, "depth on mirrors (F0 > 0.5): surface | invalid (none) | virtual (the mirrored point behind the glass)")
       ->capture_default_str();
   cmd->add_option("--threads", p.threads, "render threads (0 = all cores; output does not depend on it)")
       ->capture_default_str();

@@ -38,9 +38,11 @@ struct ReflectiveFillParams {
   float min_tolerance = 0.01f;
   float noise_a = 0.0012f, noise_b = 0.0019f, noise_z0 = 0.4f;
   float min_inlier_ratio = 0.6f;  // of the valid ring points
-  // The inliers must surround the mask: each of at least min_sides of the four sides of its
-  // bounding box holds min_side_share of them (a plane seen on one side only is extrapolated).
-  int min_sides = 3;
+  // The inliers must lie on at least min_sides of the four sides of the mask's bounding box, each
+  // holding min_side_share of them. Two sides, adjacent (an L) or opposite (two strips), fix a
+  // plane across the mask; one strip leaves it free to tilt about the strip, and a fill from it
+  // would be an extrapolation. Two, not three: a mirror cut by the image's border is seen on two.
+  int min_sides = 2;
   float min_side_share = 0.05f;
   float max_ray_angle_deg = 80.0f;  // no fill where a ray meets the plane more obliquely
   int ransac_iterations = 128;      // deterministic (fixed seed)

@@ -161,6 +161,12 @@ RenderOutput render_view(const Scene& scene, const Intrinsics& K, const Eigen::I
       const SurfacePoint s = surface(scene, hit, o, d, params.jitter_cell);
       out.color(u, v) = tone_curve(shade(scene, s, d, params, 0), scene.exposure);
       out.depth(u, v) = hit.t;
+      if (params.virtual_mirror_depth && s.material->f0 > params.mirror_f0) {
+        // The reflected ray has |d|, so its hit parameter adds to the z-depth as the first one's.
+        const Vector3f r = d - 2.0f * d.dot(s.n) * s.n;
+        RayHit mirrored;
+        out.depth(u, v) = scene.intersect(s.x + s.n * kRayEps, r, 0.0f, INFINITY, mirrored) ? hit.t + mirrored.t : 0.0f;
+      }
       out.labels(u, v) = uint16_t(p.category[f]);
       out.planes(u, v) = p.plane[f];
       out.reflective(u, v) = s.material->f0 > 0.0f ? 1 : 0;

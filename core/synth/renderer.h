@@ -20,11 +20,17 @@ struct RenderParams {
   int max_bounces = 2;        // reflection depth; deeper bounces use one unjittered ray
   bool shadows = true;        // shadow rays from first-hit surfaces to each light
   float jitter_cell = 0.002f; // metres: surface quantisation of the roughness jitter hash
+  // Depth on mirrors (first hit with F0 > mirror_f0) as a sensor that sees through the glass
+  // reports it: the z-depth of the mirrored point (the first hit of the reflected ray, unfolded
+  // behind the glass), 0 when the reflected ray leaves the scene. Colour and labels are unchanged.
+  bool virtual_mirror_depth = false;
+  float mirror_f0 = 0.5f;
 };
 
 struct RenderOutput {
   ColorImage color;          // display-ready RGB in [0,1] (tone-mapped, gamma 2.2)
   DepthImage depth;          // z-depth of the first hit along the optical axis, metres, 0 = none
+                             // (of the mirrored point on mirrors with virtual_mirror_depth)
   LabelImage labels;         // semantic category of the first hit (Category), 0 = none
   LabelImage planes;         // plane id of the first hit, 0 = curved or none
   MaskImage reflective;      // 1 where the first hit has F0 > 0

@@ -70,6 +70,8 @@ struct ViewWriter {
     const double c0 = cpu_seconds();
     RenderParams rp = params.render;
     rp.threads = params.threads;
+    rp.virtual_mirror_depth = params.mirror_depth == MirrorDepth::Virtual;
+    rp.mirror_f0 = noise.mirror_f0;
     auto out = std::make_shared<RenderOutput>(render_view(scene, K, T_wc.cast<float>(), rp));
     if (noise.gaussian || noise.edge_dropout || noise.invalid_on_mirrors)
       apply_depth_noise(out->depth, out->material, scene, noise, noise_frame, params.seed);
@@ -90,7 +92,16 @@ struct ViewWriter {
 MirrorDepth parse_mirror_depth(const std::string& text) {
   if (text == "surface") return MirrorDepth::Surface;
   if (text == "invalid") return MirrorDepth::Invalid;
-  throw std::invalid_argument("--mirror-depth must be 'surface' or 'invalid', got '" + text + "'");
+  if (text == "virtual") return MirrorDepth::Virtual;
+  throw std::invalid_argument("--mirror-depth must be 'surface', 'invalid' or 'virtual', got '" + text + "'");
+}
+
+const char* to_string(MirrorDepth m) {
+  switch (m) {
+    case MirrorDepth::Invalid: return "invalid";
+    case MirrorDepth::Virtual: return "virtual";
+    default: return "surface";
+  }
 }
 
 void validate(const SynthParams& p) {

@@ -15,8 +15,10 @@ namespace rrg::synth {
 inline constexpr float kDepthScale = 5000.0f;     // depth PNG units per metre (TUM)
 inline constexpr const char* kGeneratorVersion = "1.0";
 
-enum class MirrorDepth { Surface, Invalid };  // depth on F0 > 0.5 surfaces: the surface, or 0
-MirrorDepth parse_mirror_depth(const std::string& text);  // "surface" | "invalid", else throws
+// Depth on F0 > 0.5 surfaces: the surface, 0, or the mirrored point behind the glass.
+enum class MirrorDepth { Surface, Invalid, Virtual };
+MirrorDepth parse_mirror_depth(const std::string& text);  // "surface" | "invalid" | "virtual", else throws
+const char* to_string(MirrorDepth m);
 
 struct SynthParams {
   std::string preset = "living_room";

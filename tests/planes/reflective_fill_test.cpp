@@ -106,22 +106,33 @@ TEST(ReflectiveFill, SurroundingsThatAreNotOnePlaneLeaveTheHole) {
   for (size_t i = 0; i < depth.size(); ++i) ASSERT_EQ(depth[i], before[i]);
 }
 
-TEST(ReflectiveFill, APlaneSeenOnTwoSidesIsNotExtrapolated) {
+TEST(ReflectiveFill, APlaneSeenOnOneSideIsNotExtrapolated) {
+  // In the image's top-left corner the ring lies on two sides (right, below): filled.
   DepthImage depth = wall_image();
-  const SemanticMask mirror = rect_mask(0, 0, 70, 60);  // in the image's top-left corner
+  const SemanticMask corner = rect_mask(0, 0, 70, 60);
   for (int v = 0; v <= 60; ++v)
     for (int u = 0; u <= 70; ++u) depth(u, v) = 0.0f;
-  const ReflectiveFillResult r = fill_reflective_depth(depth, std::span(&mirror, 1), kK, ReflectiveFillParams{});
+  const ReflectiveFillResult r = fill_reflective_depth(depth, std::span(&corner, 1), kK, ReflectiveFillParams{});
   ASSERT_EQ(r.masks.size(), 1u);
   EXPECT_EQ(r.masks[0].sides, 2);
-  EXPECT_EQ(r.masks[0].filled, 0);
-  EXPECT_EQ(depth(10, 10), 0.0f);
-  // Two sides suffice when asked for.
-  ReflectiveFillParams two;
-  two.min_sides = 2;
-  const ReflectiveFillResult r2 = fill_reflective_depth(depth, std::span(&mirror, 1), kK, two);
-  EXPECT_EQ(r2.masks[0].filled, 71 * 61);
+  EXPECT_EQ(r.masks[0].filled, 71 * 61);
   EXPECT_NEAR(depth(10, 10), wall_depth(10, 10), 1e-4f);
+  // Across the top of the image the ring lies below it only: a strip, not filled.
+  DepthImage top = wall_image();
+  const SemanticMask band = rect_mask(0, 0, kK.width - 1, 60);
+  for (int v = 0; v <= 60; ++v)
+    for (int u = 0; u < kK.width; ++u) top(u, v) = 0.0f;
+  const ReflectiveFillResult r1 = fill_reflective_depth(top, std::span(&band, 1), kK, ReflectiveFillParams{});
+  ASSERT_EQ(r1.masks.size(), 1u);
+  EXPECT_EQ(r1.masks[0].sides, 1);
+  EXPECT_EQ(r1.masks[0].filled, 0);
+  EXPECT_NE(r1.masks[0].skipped.find("1 side"), std::string::npos) << r1.masks[0].skipped;
+  EXPECT_EQ(top(10, 10), 0.0f);
+  // One side suffices when asked for.
+  ReflectiveFillParams one;
+  one.min_sides = 1;
+  EXPECT_EQ(fill_reflective_depth(top, std::span(&band, 1), kK, one).masks[0].filled, kK.width * 61);
+  EXPECT_NEAR(top(10, 10), wall_depth(10, 10), 1e-4f);
 }
 
 TEST(ReflectiveFill, ASurfaceTheSensorKeptIsLeftAlone) {

@@ -75,11 +75,12 @@ TEST_F(SessionTest, IdentificationFramesReportTheirExposureGain) {
   }
 }
 
-// A sensor that loses the mirror (docs/planes.md "Mirrors without depth"): every pixel labelled
-// mirror (glass and frame) comes without depth. With planes.fill the session fills them from the
-// wall around the mirror before tracking and fusion, so the TSDF holds a surface there, within a
-// few cm of the glass (the wall is 1.5 cm behind it, the frame 3.5 cm in front); without it the
-// map keeps the hole.
+// Sensors that lose the mirror (docs/planes.md "Mirrors without depth"): every pixel labelled
+// mirror (glass and frame) comes without depth, or with the depth of a point 1.5 m behind it (the
+// mirrored room, seen through the glass). With planes.fill the session fills them from the wall
+// around the mirror before tracking and fusion, so the TSDF holds a surface there, within a few cm
+// of the glass (the wall is 1.5 cm behind it, the frame 3.5 cm in front); without it the map keeps
+// the hole, or the room behind the glass.
 TEST_F(SessionTest, ALostMirrorIsFilledFromTheWallAroundIt) {
   const auto d = io::open_dataset(root());
   const CategoryTable cats = read_category_table(io::synth_scene_file(root(), "categories.json"));
@@ -92,36 +93,39 @@ TEST_F(SessionTest, ALostMirrorIsFilledFromTheWallAroundIt) {
   int64_t mirror_px = 0;
   for (const uint16_t l : probe.labels->pixels()) mirror_px += l == mirror_id;
   ASSERT_GT(mirror_px, int64_t(probe.labels->size() / 20)) << "the mirror is not in view";
-  for (const bool fill : {true, false}) {
-    SCOPED_TRACE(fill ? "fill" : "no fill");
-    SessionConfig c = config(*d);
-    c.gt_poses = true;
-    c.planes.fill.enabled = fill;
-    Session s(c);
-    int64_t filled = 0;
-    for (size_t i = 0; i < 20; ++i) {
-      SessionFrame f = frame(*d, i, true);
-      for (size_t k = 0; k < f.depth.size(); ++k)
-        if ((*f.labels)[k] == mirror_id) f.depth[k] = 0.0f;
-      filled += s.process(f).filled_pixels;
+  for (const bool through : {false, true})
+    for (const bool fill : {true, false}) {
+      SCOPED_TRACE(std::string(through ? "seen through" : "lost") + (fill ? ", fill" : ", no fill"));
+      SessionConfig c = config(*d);
+      c.gt_poses = true;
+      c.planes.fill.enabled = fill;
+      Session s(c);
+      int64_t filled = 0;
+      for (size_t i = 0; i < 20; ++i) {
+        SessionFrame f = frame(*d, i, true);
+        for (size_t k = 0; k < f.depth.size(); ++k)
+          if ((*f.labels)[k] == mirror_id) f.depth[k] = through && f.depth[k] > 0.0f ? f.depth[k] + 1.5f : 0.0f;
+        filled += s.process(f).filled_pixels;
+      }
+      s.finish();
+      const SessionView v = s.render(c.K, *probe.pose);
+      int64_t with_depth = 0, close = 0, behind = 0;
+      for (size_t k = 0; k < v.depth.size(); ++k) {
+        if ((*probe.labels)[k] != mirror_id) continue;
+        const float z = v.depth[k], z_true = probe.depth[k];
+        with_depth += z > 0.0f;
+        close += z > 0.0f && z_true > 0.0f && std::abs(z - z_true) < 0.05f;
+        behind += z > 0.0f && z_true > 0.0f && z > z_true + 1.0f;
+      }
+      if (fill) {
+        EXPECT_GT(filled, 20 * mirror_px / 4) << "frames filled";
+        EXPECT_GT(close, mirror_px * 8 / 10) << with_depth << " of " << mirror_px << " mirror pixels with depth";
+      } else {
+        EXPECT_EQ(filled, 0);
+        if (through) EXPECT_GT(behind, mirror_px / 2) << "the room behind the glass is in the map";
+        else EXPECT_LT(with_depth, mirror_px / 10) << "the hole is in the map";
+      }
     }
-    s.finish();
-    const SessionView v = s.render(c.K, *probe.pose);
-    int64_t with_depth = 0, close = 0;
-    for (size_t k = 0; k < v.depth.size(); ++k) {
-      if ((*probe.labels)[k] != mirror_id) continue;
-      const float z = v.depth[k], z_true = probe.depth[k];
-      with_depth += z > 0.0f;
-      close += z > 0.0f && z_true > 0.0f && std::abs(z - z_true) < 0.05f;
-    }
-    if (fill) {
-      EXPECT_GT(filled, 20 * mirror_px / 4) << "frames filled";
-      EXPECT_GT(close, mirror_px * 8 / 10) << with_depth << " of " << mirror_px << " mirror pixels with depth";
-    } else {
-      EXPECT_EQ(filled, 0);
-      EXPECT_LT(with_depth, mirror_px / 10) << "the hole is in the map";
-    }
-  }
 }
 
 TEST_F(SessionTest, TracksTheSequence) {

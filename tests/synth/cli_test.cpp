@@ -170,6 +170,28 @@ TEST(SynthCli, SameBytesWhateverTheThreadCountAndNoiseIsDeterministic) {
   }
   EXPECT_GT(mirror_px, 0u);
   EXPECT_GT(zero_px, mirror_px / 2) << "the mirror glass (most of the mirror category) has no depth";
+  // --mirror-depth virtual: the glass reports the mirrored room behind it, farther than the glass
+  // (the surface depth of frame 0 of run a, same pose), everything else as with surface depth.
+  const auto v = run_rrg("synth --preset mirror_room --frames 1 --width 48 --height 36 --novel 0 --mirror-depth virtual --out " +
+                         (tmp / "v").string());
+  ASSERT_EQ(v.exit_code, 0) << v.output;
+  const auto s = run_rrg("synth --preset mirror_room --frames 1 --width 48 --height 36 --novel 0 --out " + (tmp / "s").string());
+  ASSERT_EQ(s.exit_code, 0) << s.output;
+  const DepthImage virt = io::read_depth(tmp / "v" / "depth" / "000000.png", 5000.0f);
+  const DepthImage surf = io::read_depth(tmp / "s" / "depth" / "000000.png", 5000.0f);
+  size_t behind = 0, same_elsewhere = 0, elsewhere = 0;
+  for (size_t k = 0; k < d.size(); ++k) {
+    if (d[k] == 0.0f && surf[k] > 0.0f) {  // the glass (zeroed by invalid)
+      behind += virt[k] > surf[k] + 0.3f;
+    } else {
+      ++elsewhere;
+      same_elsewhere += virt[k] == surf[k];
+    }
+  }
+  EXPECT_GT(behind, zero_px * 9 / 10) << "the glass reports the room behind it";
+  EXPECT_EQ(same_elsewhere, elsewhere) << "only the glass changes";
+  EXPECT_EQ(slurp(tmp / "v" / "rgb" / "000000.png"), slurp(tmp / "s" / "rgb" / "000000.png"));
+  EXPECT_EQ(read_json(tmp / "v" / "scene.json")["parameters"]["mirror_depth"], "virtual");
 }
 
 // --exposure scales each frame's colour by the gain of its timestamp (clipped to 1, then 8-bit)
