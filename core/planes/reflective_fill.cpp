@@ -132,6 +132,7 @@ ReflectiveFillResult fill_reflective_depth(DepthImage& depth, std::span<const Se
     if (!sm.reflective) continue;
     ReflectiveFillMask rec;
     rec.label = sm.label;
+    rec.mask_index = size_t(&sm - masks.data());
     Box box{w, h, -1, -1};
     for (int v = 0; v < h; ++v)
       for (int u = 0; u < w; ++u)
@@ -217,6 +218,89 @@ ReflectiveFillResult fill_reflective_depth(DepthImage& depth, std::span<const Se
       }
     out.pixels += rec.filled;
     if (rec.filled == 0) rec.skipped = "no pixel faces the plane";
+    out.masks.push_back(std::move(rec));
+  }
+  return out;
+}
+
+std::vector<FillRegion> fill_regions(const ReflectiveFillResult& result, std::span<const SemanticMask> masks,
+                                     const Intrinsics& K, const Eigen::Isometry3f& T_wc, float cell) {
+  if (!(cell > 0.0f)) throw std::invalid_argument("fill_regions: cell must be > 0");
+  std::vector<FillRegion> out;
+  for (const ReflectiveFillMask& m : result.masks) {
+    if (m.filled == 0 || !m.fitted) continue;
+    if (m.mask_index >= masks.size()) throw std::invalid_argument("fill_regions: the masks are not those of the fill");
+    const MaskImage& mask = masks[m.mask_index].mask;
+    if (mask.width() != K.width || mask.height() != K.height)
+      throw std::invalid_argument("fill_regions: mask and intrinsics sizes differ");
+    std::vector<Eigen::Vector3f> points;  // the mask's pixels on the plane, world frame
+    for (int v = 0; v < K.height; ++v)
+      for (int u = 0; u < K.width; ++u) {
+        if (!mask(u, v)) continue;
+        const Eigen::Vector3f r((float(u) - K.cx) / K.fx, (float(v) - K.cy) / K.fy, 1.0f);
+        const float nd = m.plane.n.dot(r);
+        if (!(nd < 0.0f)) continue;
+        const float z = -m.plane.d / nd;
+        if (z > 0.0f && std::isfinite(z)) points.push_back(T_wc * (z * r));
+      }
+    if (points.empty()) continue;
+    FillRegion region;
+    region.label = m.label;
+    region.plane = m.plane.transformed(T_wc);
+    region.footprint = Footprint(PlaneBasis::from_plane(region.plane, points.front()), cell);
+    region.footprint.add_points(points);
+    out.push_back(std::move(region));
+  }
+  return out;
+}
+
+ReflectiveFillResult fill_from_regions(DepthImage& depth, std::span<const FillRegion> regions, const Intrinsics& K,
+                                       const Eigen::Isometry3f& T_wc, const ReflectiveFillParams& params) {
+  params.validate();
+  const int w = depth.width(), h = depth.height();
+  if (K.width != w || K.height != h)
+    throw std::invalid_argument(fmt::format("fill_from_regions: intrinsics {}x{} but depth {}x{}", K.width, K.height, w, h));
+  ReflectiveFillResult out;
+  out.filled = MaskImage(w, h, 0);
+  const float cos_max = std::cos(params.max_ray_angle_deg * float(M_PI) / 180.0f);
+  const Eigen::Isometry3f T_cw = T_wc.inverse();
+  for (const FillRegion& region : regions) {
+    ReflectiveFillMask rec;
+    rec.label = region.label;
+    rec.plane = region.plane.transformed(T_cw);  // camera frame
+    rec.fitted = true;
+    if (!(rec.plane.d > 0.0f)) {  // the camera is behind the surface
+      rec.skipped = "seen from behind";
+      out.masks.push_back(std::move(rec));
+      continue;
+    }
+    const Footprint& fp = region.footprint;
+    const float cell = fp.cell_size();
+    const auto on_footprint = [&](const Eigen::Vector3f& p_w) {  // dilated by one cell
+      const Eigen::Vector2f q = fp.basis().project(p_w) / cell;
+      const int i = int(std::floor(q.x())), j = int(std::floor(q.y()));
+      for (int di = -1; di <= 1; ++di)
+        for (int dj = -1; dj <= 1; ++dj)
+          if (fp.contains_cell(i + di, j + dj)) return true;
+      return false;
+    };
+    for (int v = 0; v < h; ++v)
+      for (int u = 0; u < w; ++u) {
+        const Eigen::Vector3f r((float(u) - K.cx) / K.fx, (float(v) - K.cy) / K.fy, 1.0f);
+        const float nd = rec.plane.n.dot(r);
+        if (!(-nd >= cos_max * r.norm())) continue;
+        const float z = -rec.plane.d / nd;
+        if (!(z > 0.0f && z <= params.max_depth) || !on_footprint(T_wc * (z * r))) continue;
+        ++rec.pixels;
+        const float d = depth(u, v);
+        if (!(d > 0.0f) || !std::isfinite(d) || d > z + params.tolerance(z)) {
+          ++rec.missing;
+          depth(u, v) = z;
+          out.filled(u, v) = 1;
+          ++rec.filled;
+        }
+      }
+    out.pixels += rec.filled;
     out.masks.push_back(std::move(rec));
   }
   return out;

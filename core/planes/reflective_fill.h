@@ -11,8 +11,11 @@
 // (docs/planes.md "Mirrors without depth").
 #include "core/common/camera.h"
 #include "core/common/image.h"
+#include "core/planes/plane_footprint.h"
 #include "core/planes/plane_types.h"
 #include "core/planes/semantic_cue.h"
+
+#include <Eigen/Geometry>
 
 #include <cstdint>
 #include <span>
@@ -23,6 +26,9 @@ namespace rrg {
 
 struct ReflectiveFillParams {
   bool enabled = true;
+  // Frames that get no masks (the `remote` cue between identification frames) are filled from the
+  // surfaces the last fill with masks left (FillRegion below), at their tracked pose.
+  bool carry = true;
   // A mask is filled when at least this share of its pixels has no depth or depth behind the ring's
   // plane: a mirror the sensor saw has next to none (edge dropouts), a lost one most of its area.
   float min_missing = 0.25f;
@@ -55,6 +61,7 @@ struct ReflectiveFillParams {
 // What happened to one reflective mask.
 struct ReflectiveFillMask {
   std::string label;
+  size_t mask_index = 0;      // in the masks given (fill_reflective_depth)
   int64_t pixels = 0;         // mask pixels
   int64_t missing = 0;        // without depth or behind the plane (0 when no plane was fitted)
   int64_t filled = 0;         // pixels written
@@ -76,6 +83,26 @@ struct ReflectiveFillResult {
 // std::invalid_argument when a mask's size or K's differs from the depth's, or for bad params.
 ReflectiveFillResult fill_reflective_depth(DepthImage& depth, std::span<const SemanticMask> masks, const Intrinsics& K,
                                            const ReflectiveFillParams& params);
+
+// What a fill leaves for the frames that get no masks (the `remote` cue's between identification
+// frames): each filled mask's surface in the world frame, its plane and the footprint (a grid of
+// `cell` metres on the plane, plane_footprint.h) of the mask's pixels on it.
+struct FillRegion {
+  std::string label;
+  Plane plane;  // world frame
+  Footprint footprint;
+};
+
+// The regions of the masks `result` filled, seen from T_wc (camera to world) with K.
+std::vector<FillRegion> fill_regions(const ReflectiveFillResult& result, std::span<const SemanticMask> masks,
+                                     const Intrinsics& K, const Eigen::Isometry3f& T_wc, float cell = 0.05f);
+
+// Fills `depth` from regions at pose T_wc: a pixel whose ray meets a region's plane from its front,
+// within its footprint dilated by one cell, and that has no depth or depth behind the plane takes
+// the plane's depth (the same tolerance and angle limit as fill_reflective_depth). One record per
+// region in the result (pixels: those whose ray lands on the footprint).
+ReflectiveFillResult fill_from_regions(DepthImage& depth, std::span<const FillRegion> regions, const Intrinsics& K,
+                                       const Eigen::Isometry3f& T_wc, const ReflectiveFillParams& params);
 
 // Writes the filled pixels of `from` into `to` (the same fill applied to another copy of the
 // frame's depth, e.g. the tracker's filtered one). Throws std::invalid_argument on size mismatch.

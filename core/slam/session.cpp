@@ -272,6 +272,7 @@ FrameReport Session::process(const SessionFrame& frame) {
   // frames whose masks the cue gives anyway (identification frames) or at no cost (labels).
   const bool identify_due = s.fused % s.config.plane_period == 0;
   std::optional<std::vector<SemanticMask>> masks;
+  std::optional<ReflectiveFillResult> mask_fill;  // kept for its regions once the pose is known
   DepthImage filled;
   const DepthImage* D_k = &frame.depth;
   const SemanticCue& cue = s.identifier.cue();
@@ -281,10 +282,10 @@ FrameReport Session::process(const SessionFrame& frame) {
     masks = s.identifier.semantic_masks({&frame.depth, &frame.color, frame.labels ? &*frame.labels : nullptr, s.K,
                                          Eigen::Isometry3f::Identity(), frame.index, s.config.tsdf.voxel_size});
     filled = frame.depth;
-    const ReflectiveFillResult fr = fill_reflective_depth(filled, *masks, s.K, s.config.planes.fill_params());
-    report.filled_pixels = fr.pixels;
-    if (fr.pixels > 0) D_k = &filled;
-    for (const ReflectiveFillMask& m : fr.masks)
+    mask_fill = fill_reflective_depth(filled, *masks, s.K, s.config.planes.fill_params());
+    report.filled_pixels = mask_fill->pixels;
+    if (mask_fill->pixels > 0) D_k = &filled;
+    for (const ReflectiveFillMask& m : mask_fill->masks)
       spdlog::debug("frame {}: {} mask, {} px, {} missing: {}", frame.index, m.label, m.pixels, m.missing,
                     m.skipped.empty() ? fmt::format("{} px filled", m.filled) : m.skipped);
     report.times.identify = ms_since(tf);
@@ -317,6 +318,35 @@ FrameReport Session::process(const SessionFrame& frame) {
     keyframe = r.keyframe || r.first;
   }
 
+  // The fill, between frames with masks: the last fill's surfaces (world regions) at the tracked
+  // pose, for fusion and the mapper (tracking saw this frame as it came; ICP's association drops
+  // points behind the model's surface). A fill with masks leaves its regions for the next frames.
+  std::optional<DeviceImage<float>> fuse_override;  // the filtered depth, filled
+  if (report.state != TrackingState::Lost && s.config.planes.fill.enabled) {
+    const auto tf = Clock::now();
+    if (mask_fill) {
+      if (mask_fill->pixels > 0) {
+        std::vector<FillRegion> regions = fill_regions(*mask_fill, *masks, s.K, report.T_wc);
+        if (!regions.empty()) s.fill_regions = std::move(regions);
+      }
+    } else if (s.config.planes.fill.carry && !s.fill_regions.empty()) {
+      filled = frame.depth;
+      const ReflectiveFillResult fr = fill_from_regions(filled, s.fill_regions, s.K, report.T_wc, s.config.planes.fill_params());
+      report.filled_pixels = fr.pixels;
+      if (fr.pixels > 0) {
+        D_k = &filled;
+        if (const DeviceImage<float>* f = s.config.gt_poses ? nullptr : s.tracker.preprocessed_depth()) {
+          DepthImage host = f->to_host();
+          copy_filled_depth(filled, fr.filled, host);
+          fuse_override = DeviceImage<float>::from_host(host, s.config.device);
+        } else {
+          fuse_override = DeviceImage<float>::from_host(filled, s.config.device);
+        }
+      }
+    }
+    report.times.identify += ms_since(tf);
+  }
+
   // 2. identification every N_p frames (§4.1.3), then 3. fusion (§4.1.4)
   if (report.state != TrackingState::Lost) {
     DeviceImage<int32_t> plane_ids;
@@ -331,7 +361,8 @@ FrameReport Session::process(const SessionFrame& frame) {
       // spacing and fusion's normals (point-to-plane sdf, grazing test) would drop the surface
       // (docs/tracking.md); with given poses nothing was preprocessed and the raw depth is fused.
       const DeviceImage<float>* filtered = s.config.gt_poses ? nullptr : s.tracker.preprocessed_depth();
-      integrate(s.volume, filtered ? *filtered : depth, color, s.K, report.T_wc, identify ? &obs : nullptr);
+      integrate(s.volume, fuse_override ? *fuse_override : (filtered ? *filtered : depth), color, s.K, report.T_wc,
+                identify ? &obs : nullptr);
     }
     s.model.invalidate();
     report.times.fuse = ms_since(tf);

@@ -211,6 +211,8 @@ std::vector<ConfigField> config_fields(SessionConfig& c) {
       "the variance statistic takes each identification frame's intensity over its exposure gain against the map");
   t.b("planes.fill.enabled", c.planes.fill.enabled,
       "fill the depth the sensor lost on reflective masks from the plane around them (labels / remote cues)");
+  t.b("planes.fill.carry", c.planes.fill.carry,
+      "frames without masks (remote cue between identification frames) fill from the last fill's surfaces");
   t.f("planes.fill.min_missing", c.planes.fill.min_missing,
       "fill a mask when this share of its pixels has no depth or depth behind that plane");
   t.f("planes.fill.min_inlier_ratio", c.planes.fill.min_inlier_ratio, "share of the ring around the mask on one plane");

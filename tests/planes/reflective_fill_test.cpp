@@ -195,5 +195,62 @@ TEST(ReflectiveFill, TheSameFillCopiesIntoAnotherDepth) {
   EXPECT_GT(filtered(80, 60), 0.0f);
 }
 
+// A fill carried to a frame without masks: the mirror filled in view 1 (identity pose) is stored as
+// a world region, and view 2 (moved 12 cm and turned 4°) that sees through the same glass, or gets
+// no depth there, is filled from it without any mask.
+TEST(ReflectiveFill, ARegionCarriesTheFillToAViewWithoutMasks) {
+  DepthImage depth = wall_image();
+  const SemanticMask mirror = rect_mask(50, 30, 110, 90);
+  for (int v = 30; v <= 90; ++v)
+    for (int u = 50; u <= 110; ++u) depth(u, v) = 0.0f;
+  const ReflectiveFillResult r = fill_reflective_depth(depth, std::span(&mirror, 1), kK, ReflectiveFillParams{});
+  ASSERT_EQ(r.masks[0].mask_index, 0u);
+  const std::vector<FillRegion> regions = fill_regions(r, std::span(&mirror, 1), kK, Eigen::Isometry3f::Identity());
+  ASSERT_EQ(regions.size(), 1u);
+  EXPECT_EQ(regions[0].label, "mirror");
+  EXPECT_GT(regions[0].footprint.cells(), 20u);
+
+  Eigen::Isometry3f T2 = Eigen::Isometry3f::Identity();
+  T2.linear() = Eigen::AngleAxisf(4.0f * float(M_PI) / 180.0f, Eigen::Vector3f::UnitY()).toRotationMatrix();
+  T2.translation() = Eigen::Vector3f(0.12f, 0.04f, 0.0f);
+  const Plane wall_c2 = wall().transformed(T2.inverse());
+  for (const bool through : {false, true}) {
+    SCOPED_TRACE(through ? "seen through" : "lost");
+    DepthImage d2(kK.width, kK.height);
+    MaskImage glass(kK.width, kK.height, 0);
+    int64_t glass_px = 0;
+    for (int v = 0; v < kK.height; ++v)
+      for (int u = 0; u < kK.width; ++u) {
+        const Eigen::Vector3f ray((float(u) - kK.cx) / kK.fx, (float(v) - kK.cy) / kK.fy, 1.0f);
+        const float z = -wall_c2.d / wall_c2.n.dot(ray);
+        const Eigen::Vector3f p1 = T2 * (z * ray);  // view 1's camera = world
+        const Eigen::Vector2f px = kK.project(p1);
+        const bool in = px.x() >= 49.5f && px.x() <= 110.5f && px.y() >= 29.5f && px.y() <= 90.5f;
+        glass(u, v) = in;
+        glass_px += in;
+        d2(u, v) = in ? (through ? z + 1.5f : 0.0f) : z;
+      }
+    ASSERT_GT(glass_px, 2000);
+    const DepthImage before = d2;
+    const ReflectiveFillResult f = fill_from_regions(d2, regions, kK, T2, ReflectiveFillParams{});
+    ASSERT_EQ(f.masks.size(), 1u);
+    EXPECT_EQ(f.pixels, glass_px) << "every pixel of the glass, nothing else";
+    for (int v = 0; v < kK.height; ++v)
+      for (int u = 0; u < kK.width; ++u) {
+        const Eigen::Vector3f ray((float(u) - kK.cx) / kK.fx, (float(v) - kK.cy) / kK.fy, 1.0f);
+        if (glass(u, v)) EXPECT_NEAR(d2(u, v), -wall_c2.d / wall_c2.n.dot(ray), 1e-3f) << u << "," << v;
+        else EXPECT_EQ(d2(u, v), before(u, v)) << "the wall around keeps its depth";
+      }
+  }
+  // From behind the wall the region fills nothing.
+  Eigen::Isometry3f behind = Eigen::Isometry3f::Identity();
+  behind.linear() = Eigen::AngleAxisf(float(M_PI), Eigen::Vector3f::UnitY()).toRotationMatrix();
+  behind.translation() = Eigen::Vector3f(0.0f, 0.0f, 5.0f);
+  DepthImage empty(kK.width, kK.height, 0.0f);
+  const ReflectiveFillResult b = fill_from_regions(empty, regions, kK, behind, ReflectiveFillParams{});
+  EXPECT_EQ(b.pixels, 0);
+  EXPECT_EQ(b.masks[0].skipped, "seen from behind");
+}
+
 }  // namespace
 }  // namespace rrg

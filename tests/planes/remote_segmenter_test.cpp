@@ -98,10 +98,15 @@ TEST(RemoteSegmenter, ServerErrorsReachTheCaller) {
   }
 }
 
+// The segmenter serves the sequence's label images; the mirror's glass has no depth, so the remote
+// cue's mirror mask (the first cue's masks fill the depth, planes.fill) must come back for any
+// pixel to be filled. (Until 2026-12-05 the test server served no category in this mode, and this
+// test, which only checked that the run finished, passed.)
 TEST(RemoteSegmenter, EvalEndToEndThroughTheCli) {
   test::TempDir dir("planes_remote");
   const auto seq = (dir.path() / "seq").string();
-  auto r = test::run_rrg("synth --preset living_room --frames 2 --width 160 --height 120 --novel 0 --out " + seq);
+  auto r = test::run_rrg("synth --preset mirror_room --frames 2 --width 160 --height 120 --novel 0 --mirror-depth invalid --out " +
+                         seq);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   ServerProcess server("--labels " + seq);
   r = test::run_rrg("planes eval --dataset " + seq + " --semantics remote,labels --period 1 --no-fuse --json --remote " +
@@ -110,6 +115,7 @@ TEST(RemoteSegmenter, EvalEndToEndThroughTheCli) {
   const auto j = nlohmann::json::parse(r.output.substr(r.output.find('{')));
   ASSERT_EQ(j["cues"].size(), 2u);
   EXPECT_EQ(j["cues"][0]["semantics"], "remote");
+  EXPECT_GT(j["filled_pixels"].get<int64_t>(), 2 * 160 * 120 / 20) << "the remote cue returned no mirror mask";
 }
 
 }  // namespace

@@ -66,6 +66,20 @@ TEST(SessionConfig, OverridesSetFieldsAndRejectNonsense) {
   EXPECT_THROW(apply_override(c, "no_equals_sign"), std::invalid_argument);
   EXPECT_THROW(apply_override(c, "tracking.mode=orb"), std::invalid_argument);
   EXPECT_FLOAT_EQ(c.tsdf.voxel_size, 0.01f);  // failed overrides change nothing
+  // The reflective fill's keys; a value out of range names its field when the config is validated.
+  apply_override(c, "planes.fill.enabled=false");
+  apply_override(c, "planes.fill.carry=false");
+  apply_override(c, "planes.fill.min_sides=3");
+  EXPECT_FALSE(c.planes.fill.enabled);
+  EXPECT_FALSE(c.planes.fill.carry);
+  EXPECT_EQ(c.planes.fill.min_sides, 3);
+  apply_override(c, "planes.fill.min_sides=5");
+  try {
+    c.validate();
+    FAIL() << "min_sides 5 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("planes.fill.min_sides"), std::string::npos) << e.what();
+  }
 }
 
 TEST(SessionConfig, YamlFilesAreNestedAndRoundTrip) {

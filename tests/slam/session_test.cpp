@@ -128,6 +128,67 @@ TEST_F(SessionTest, ALostMirrorIsFilledFromTheWallAroundIt) {
     }
 }
 
+// The labels cue as a `remote` one behaves: masks on identification frames only (every N_p = 10).
+class IdentificationFrameLabels final : public SemanticCue {
+ public:
+  explicit IdentificationFrameLabels(std::unique_ptr<SemanticCue> labels) : labels_(std::move(labels)) {}
+  std::string name() const override { return "remote"; }
+  std::vector<SemanticMask> segment(const SemanticFrame& f) override {
+    ++calls;
+    return labels_->segment(f);
+  }
+  int calls = 0;
+
+ private:
+  std::unique_ptr<SemanticCue> labels_;
+};
+
+// A sensor that sees through the mirror, with masks on identification frames only (the `remote`
+// cue): frames 0 and 10 fill from their masks, the 18 frames between from the surface those fills
+// left (FillRegion, at the tracked pose), so the map holds the glass, not the room behind it.
+TEST_F(SessionTest, FramesWithoutMasksFillFromTheLastFill) {
+  const auto d = io::open_dataset(root());
+  const CategoryTable cats = read_category_table(io::synth_scene_file(root(), "categories.json"));
+  uint16_t mirror_id = 0;
+  for (const auto& [id, name] : cats.names)
+    if (name == "mirror") mirror_id = id;
+  for (const bool carry : {true, false}) {
+    SCOPED_TRACE(carry ? "carry" : "no carry");
+    SessionConfig c = config(*d);
+    c.gt_poses = true;
+    c.planes.fill.carry = carry;
+    auto cue = std::make_unique<IdentificationFrameLabels>(make_label_semantics(cats, default_prompts()));
+    IdentificationFrameLabels* probe_cue = cue.get();
+    Session s(c, std::move(cue));
+    std::vector<int64_t> filled(20, 0);
+    for (size_t i = 0; i < 20; ++i) {
+      SessionFrame f = frame(*d, i, true);
+      for (size_t k = 0; k < f.depth.size(); ++k)
+        if ((*f.labels)[k] == mirror_id && f.depth[k] > 0.0f) f.depth[k] += 1.5f;
+      filled[i] = s.process(f).filled_pixels;
+    }
+    s.finish();
+    EXPECT_EQ(probe_cue->calls, 2) << "masks on frames 0 and 10 only";
+    for (size_t i = 0; i < 20; ++i) EXPECT_EQ(filled[i] > 0, carry || i % 10 == 0) << "frame " << i;
+    const SessionFrame probe = frame(*d, 15, true);
+    const SessionView v = s.render(c.K, *probe.pose);
+    int64_t mirror_px = 0, close = 0, behind = 0;
+    for (size_t k = 0; k < v.depth.size(); ++k) {
+      if ((*probe.labels)[k] != mirror_id || !(probe.depth[k] > 0.0f)) continue;
+      ++mirror_px;
+      close += v.depth[k] > 0.0f && std::abs(v.depth[k] - probe.depth[k]) < 0.05f;
+      behind += v.depth[k] > probe.depth[k] + 1.0f;
+    }
+    ASSERT_GT(mirror_px, 0);
+    if (carry) {
+      EXPECT_GT(close, mirror_px * 8 / 10);
+      EXPECT_LT(behind, mirror_px / 20) << "the room behind the glass is in the map";
+    } else {
+      EXPECT_GT(behind, mirror_px / 10) << "the frames between fuse the room behind the glass";
+    }
+  }
+}
+
 TEST_F(SessionTest, TracksTheSequence) {
   const auto d = io::open_dataset(root());
   Session s(config(*d));

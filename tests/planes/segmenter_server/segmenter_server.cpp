@@ -37,8 +37,11 @@ class TestSegmenter final : public rrg::v1::Segmenter::Service {
     if (labels_root_.empty()) return;
     std::ifstream in(rrg::io::synth_scene_file(labels_root_, "categories.json"));
     if (!in) throw std::runtime_error("no categories.json in " + labels_root_);
-    for (const auto& c : nlohmann::json::parse(in).at("categories"))
-      categories_[c.at("name").get<std::string>()] = c.at("id").get<uint16_t>();
+    // The parsed document must outlive the loop: `for (c : parse(in).at(...))` ranges over a member
+    // of a temporary destroyed before the first iteration (it served no category at all).
+    const nlohmann::json doc = nlohmann::json::parse(in);
+    for (const auto& c : doc.at("categories")) categories_[c.at("name").get<std::string>()] = c.at("id").get<uint16_t>();
+    if (categories_.empty()) throw std::runtime_error("no categories in " + labels_root_ + "/categories.json");
   }
 
   grpc::Status Segment(grpc::ServerContext*, const rrg::v1::SegmentRequest* req,
