@@ -32,6 +32,14 @@ DepthImage wall_image() {
   return d;
 }
 
+// The wall with the pixels of [x0, x1] x [y0, y1] lost (no depth).
+DepthImage wall_with_hole(int x0, int y0, int x1, int y1) {
+  DepthImage d = wall_image();
+  for (int v = y0; v <= y1; ++v)
+    for (int u = x0; u <= x1; ++u) d(u, v) = 0.0f;
+  return d;
+}
+
 SemanticMask rect_mask(int x0, int y0, int x1, int y1, bool reflective = true, const char* label = "mirror") {
   SemanticMask m;
   m.mask = MaskImage(kK.width, kK.height, 0);
@@ -43,10 +51,8 @@ SemanticMask rect_mask(int x0, int y0, int x1, int y1, bool reflective = true, c
 }
 
 TEST(ReflectiveFill, ALostMirrorTakesTheDepthOfTheWallAroundIt) {
-  DepthImage depth = wall_image();
+  DepthImage depth = wall_with_hole(50, 30, 110, 90);  // the glass: no depth
   const SemanticMask mirror = rect_mask(50, 30, 110, 90);
-  for (int v = 30; v <= 90; ++v)
-    for (int u = 50; u <= 110; ++u) depth(u, v) = 0.0f;  // the glass: no depth
   const DepthImage before = depth;
   const ReflectiveFillResult r = fill_reflective_depth(depth, std::span(&mirror, 1), kK, ReflectiveFillParams{});
   ASSERT_EQ(r.masks.size(), 1u);
@@ -108,20 +114,16 @@ TEST(ReflectiveFill, SurroundingsThatAreNotOnePlaneLeaveTheHole) {
 
 TEST(ReflectiveFill, APlaneSeenOnOneSideIsNotExtrapolated) {
   // In the image's top-left corner the ring lies on two sides (right, below): filled.
-  DepthImage depth = wall_image();
+  DepthImage depth = wall_with_hole(0, 0, 70, 60);
   const SemanticMask corner = rect_mask(0, 0, 70, 60);
-  for (int v = 0; v <= 60; ++v)
-    for (int u = 0; u <= 70; ++u) depth(u, v) = 0.0f;
   const ReflectiveFillResult r = fill_reflective_depth(depth, std::span(&corner, 1), kK, ReflectiveFillParams{});
   ASSERT_EQ(r.masks.size(), 1u);
   EXPECT_EQ(r.masks[0].sides, 2);
   EXPECT_EQ(r.masks[0].filled, 71 * 61);
   EXPECT_NEAR(depth(10, 10), wall_depth(10, 10), 1e-4f);
   // Across the top of the image the ring lies below it only: a strip, not filled.
-  DepthImage top = wall_image();
+  DepthImage top = wall_with_hole(0, 0, kK.width - 1, 60);
   const SemanticMask band = rect_mask(0, 0, kK.width - 1, 60);
-  for (int v = 0; v <= 60; ++v)
-    for (int u = 0; u < kK.width; ++u) top(u, v) = 0.0f;
   const ReflectiveFillResult r1 = fill_reflective_depth(top, std::span(&band, 1), kK, ReflectiveFillParams{});
   ASSERT_EQ(r1.masks.size(), 1u);
   EXPECT_EQ(r1.masks[0].sides, 1);
@@ -150,10 +152,8 @@ TEST(ReflectiveFill, ASurfaceTheSensorKeptIsLeftAlone) {
 }
 
 TEST(ReflectiveFill, OnlyReflectiveMasksAreConsidered) {
-  DepthImage depth = wall_image();
+  DepthImage depth = wall_with_hole(50, 30, 110, 90);
   const SemanticMask sofa = rect_mask(50, 30, 110, 90, false, "sofa");
-  for (int v = 30; v <= 90; ++v)
-    for (int u = 50; u <= 110; ++u) depth(u, v) = 0.0f;
   const ReflectiveFillResult r = fill_reflective_depth(depth, std::span(&sofa, 1), kK, ReflectiveFillParams{});
   EXPECT_TRUE(r.masks.empty());
   EXPECT_EQ(depth(80, 60), 0.0f);
@@ -182,10 +182,8 @@ TEST(ReflectiveFill, BadInputIsRejected) {
 }
 
 TEST(ReflectiveFill, TheSameFillCopiesIntoAnotherDepth) {
-  DepthImage depth = wall_image();
+  DepthImage depth = wall_with_hole(50, 30, 110, 90);
   const SemanticMask mirror = rect_mask(50, 30, 110, 90);
-  for (int v = 30; v <= 90; ++v)
-    for (int u = 50; u <= 110; ++u) depth(u, v) = 0.0f;
   DepthImage filtered = depth;
   filtered(0, 0) = 9.0f;  // differs outside the fill
   const ReflectiveFillResult r = fill_reflective_depth(depth, std::span(&mirror, 1), kK, ReflectiveFillParams{});
@@ -199,10 +197,8 @@ TEST(ReflectiveFill, TheSameFillCopiesIntoAnotherDepth) {
 // a world region, and view 2 (moved 12 cm and turned 4°) that sees through the same glass, or gets
 // no depth there, is filled from it without any mask.
 TEST(ReflectiveFill, ARegionCarriesTheFillToAViewWithoutMasks) {
-  DepthImage depth = wall_image();
+  DepthImage depth = wall_with_hole(50, 30, 110, 90);
   const SemanticMask mirror = rect_mask(50, 30, 110, 90);
-  for (int v = 30; v <= 90; ++v)
-    for (int u = 50; u <= 110; ++u) depth(u, v) = 0.0f;
   const ReflectiveFillResult r = fill_reflective_depth(depth, std::span(&mirror, 1), kK, ReflectiveFillParams{});
   ASSERT_EQ(r.masks[0].mask_index, 0u);
   const std::vector<FillRegion> regions = fill_regions(r, std::span(&mirror, 1), kK, Eigen::Isometry3f::Identity());

@@ -16,6 +16,12 @@ namespace {
 
 class SessionTest : public test::SynthSessionTest<SessionTest, 24> {
  protected:
+  static CategoryTable categories() { return read_category_table(io::synth_scene_file(root(), "categories.json")); }
+  static uint16_t category_id(const std::string& name) {
+    for (const auto& [id, n] : categories().names)
+      if (n == name) return id;
+    return 0;
+  }
   static SessionConfig config(const io::Dataset& d) { return base_config(d); }
   static void run(Session& s, const io::Dataset& d, size_t n, bool poses_always) {
     for (size_t i = 0; i < n; ++i) s.process(frame(d, i, poses_always || i == 0));
@@ -83,10 +89,7 @@ TEST_F(SessionTest, IdentificationFramesReportTheirExposureGain) {
 // the hole, or the room behind the glass.
 TEST_F(SessionTest, ALostMirrorIsFilledFromTheWallAroundIt) {
   const auto d = io::open_dataset(root());
-  const CategoryTable cats = read_category_table(io::synth_scene_file(root(), "categories.json"));
-  uint16_t mirror_id = 0;
-  for (const auto& [id, name] : cats.names)
-    if (name == "mirror") mirror_id = id;
+  const uint16_t mirror_id = category_id("mirror");
   ASSERT_NE(mirror_id, 0);
   const size_t view = 15;
   const SessionFrame probe = frame(*d, view, true);
@@ -148,16 +151,14 @@ class IdentificationFrameLabels final : public SemanticCue {
 // left (FillRegion, at the tracked pose), so the map holds the glass, not the room behind it.
 TEST_F(SessionTest, FramesWithoutMasksFillFromTheLastFill) {
   const auto d = io::open_dataset(root());
-  const CategoryTable cats = read_category_table(io::synth_scene_file(root(), "categories.json"));
-  uint16_t mirror_id = 0;
-  for (const auto& [id, name] : cats.names)
-    if (name == "mirror") mirror_id = id;
+  const uint16_t mirror_id = category_id("mirror");
+  ASSERT_NE(mirror_id, 0);
   for (const bool carry : {true, false}) {
     SCOPED_TRACE(carry ? "carry" : "no carry");
     SessionConfig c = config(*d);
     c.gt_poses = true;
     c.planes.fill.carry = carry;
-    auto cue = std::make_unique<IdentificationFrameLabels>(make_label_semantics(cats, default_prompts()));
+    auto cue = std::make_unique<IdentificationFrameLabels>(make_label_semantics(categories(), default_prompts()));
     IdentificationFrameLabels* probe_cue = cue.get();
     Session s(c, std::move(cue));
     std::vector<int64_t> filled(20, 0);
