@@ -325,7 +325,8 @@ FrameReport Session::process(const SessionFrame& frame) {
   if (report.state != TrackingState::Lost && s.config.planes.fill.enabled) {
     const auto tf = Clock::now();
     if (mask_fill) {
-      if (mask_fill->pixels > 0) {
+      // (with masks on every frame, as with labels, there is nothing to carry)
+      if (mask_fill->pixels > 0 && s.config.planes.fill.carry && !cue.masks_with_every_frame()) {
         std::vector<FillRegion> regions = fill_regions(*mask_fill, *masks, s.K, report.T_wc);
         if (!regions.empty()) s.fill_regions = std::move(regions);
       }
