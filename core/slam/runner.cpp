@@ -277,6 +277,13 @@ RunResult run_dataset(const RunOptions& o) {
   m.base_gaussians = st.mapping.base_gaussians;
   m.reflection_gaussians = st.mapping.reflection_gaussians;
   m.reflective_planes = int64_t(st.reflective_planes.size());
+  for (const FrameReport& r : reports) {
+    m.filled_frames += r.filled_pixels > 0;
+    m.filled_pixels += r.filled_pixels;
+  }
+  if (m.filled_frames > 0)
+    spdlog::info("run: depth the sensor lost on reflective masks filled in {} of {} frames, {} pixels (planes.fill)",
+                 m.filled_frames, reports.size(), m.filled_pixels);
   result.trajectory = session.trajectory();
   if (dataset->has_ground_truth() && result.trajectory.size() < eval::kMinAlignedPoses) {
     spdlog::warn("run: no ATE: {} pose(s), the alignment needs at least {}", result.trajectory.size(),
@@ -386,6 +393,7 @@ std::string metrics_json(const RunMetrics& m) {
   j["base_gaussians"] = m.base_gaussians;
   j["reflection_gaussians"] = m.reflection_gaussians;
   j["reflective_planes"] = m.reflective_planes;
+  j["reflective_fill"] = {{"frames", m.filled_frames}, {"pixels", m.filled_pixels}};
   return j.dump(2) + "\n";
 }
 

@@ -73,6 +73,8 @@ struct RunMetrics {
   std::optional<double> accuracy_cm, completion_cm, completion_ratio, completion_whole_cm, observed_fraction;
   double wall_s = 0, fps = 0;                 // whole run, frames / wall time (loading included)
   int64_t base_gaussians = 0, reflection_gaussians = 0, reflective_planes = 0;
+  // Depth filled on reflective masks (planes.fill): frames with a fill, and pixels in all.
+  int64_t filled_frames = 0, filled_pixels = 0;
 };
 
 struct RunTimings {
