@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <stdexcept>
 
@@ -112,6 +113,25 @@ bool fit_ring_plane(const std::vector<RingPoint>& ring, const ReflectiveFillPara
   return true;
 }
 
+Eigen::Vector3f pixel_ray(const Intrinsics& K, int u, int v) {  // z = 1
+  return {(float(u) - K.cx) / K.fx, (float(v) - K.cy) / K.fy, 1.0f};
+}
+
+// Depth along the optical axis at which pixel (u, v)'s ray meets `plane` (camera frame) on its
+// camera-facing side; 0 when it does not, meets it more obliquely than cos_max, or beyond max_depth.
+float plane_depth(const Plane& plane, const Intrinsics& K, int u, int v, float cos_max, float max_depth) {
+  const Eigen::Vector3f d = pixel_ray(K, u, v);
+  const float nd = plane.n.dot(d);  // < 0 when the ray meets the camera-facing side
+  if (!(-nd >= cos_max * d.norm())) return 0.0f;
+  const float z = -plane.d / nd;
+  return z > 0.0f && z <= max_depth ? z : 0.0f;
+}
+
+// Depth d the sensor lost where the plane is at z: none, or behind the plane beyond the tolerance.
+bool lost(float d, float z, const ReflectiveFillParams& params) {
+  return !(d > 0.0f) || !std::isfinite(d) || (z > 0.0f && d > z + params.tolerance(z));
+}
+
 }  // namespace
 
 ReflectiveFillResult fill_reflective_depth(DepthImage& depth, std::span<const SemanticMask> masks, const Intrinsics& K,
@@ -127,7 +147,6 @@ ReflectiveFillResult fill_reflective_depth(DepthImage& depth, std::span<const Se
   ReflectiveFillResult out;
   out.filled = MaskImage(w, h, 0);
   const float cos_max = std::cos(params.max_ray_angle_deg * float(M_PI) / 180.0f);
-  const auto ray = [&](int u, int v) { return Eigen::Vector3f((float(u) - K.cx) / K.fx, (float(v) - K.cy) / K.fy, 1.0f); };
   for (const SemanticMask& sm : masks) {
     if (!sm.reflective) continue;
     ReflectiveFillMask rec;
@@ -157,7 +176,7 @@ ReflectiveFillResult fill_reflective_depth(DepthImage& depth, std::span<const Se
       for (int u = std::max(0, box.x0 - r); u <= std::min(w - 1, box.x1 + r); ++u) {
         const float z = depth(u, v);
         if (!grown(u, v) || sm.mask(u, v) || !(z > 0.0f) || !std::isfinite(z)) continue;
-        ring.push_back({z * ray(u, v), u, v, params.tolerance(z)});
+        ring.push_back({z * pixel_ray(K, u, v), u, v, params.tolerance(z)});
       }
     rec.ring_points = int64_t(ring.size());
     if (rec.ring_points < params.min_ring_points) {
@@ -180,20 +199,10 @@ ReflectiveFillResult fill_reflective_depth(DepthImage& depth, std::span<const Se
     }
     rec.inlier_ratio = float(inliers) / float(ring.size());
     for (const int64_t s : side) rec.sides += s > 0 && float(s) >= params.min_side_share * float(inliers);
-    // Per mask pixel: where its ray meets the plane (0 when behind the camera, too oblique or too far).
-    const auto plane_depth = [&](int u, int v) {
-      const Eigen::Vector3f d = ray(u, v);
-      const float nd = rec.plane.n.dot(d);  // < 0 when the ray meets the plane's camera-facing side
-      if (!(-nd >= cos_max * d.norm())) return 0.0f;
-      const float z = -rec.plane.d / nd;
-      return z > 0.0f && z <= params.max_depth ? z : 0.0f;
-    };
-    const auto missing = [&](float d, float z) {  // no depth, or depth behind the plane
-      return !(d > 0.0f) || !std::isfinite(d) || (z > 0.0f && d > z + params.tolerance(z));
-    };
+    const auto z_at = [&](int u, int v) { return plane_depth(rec.plane, K, u, v, cos_max, params.max_depth); };
     for (int v = box.y0; v <= box.y1; ++v)
       for (int u = box.x0; u <= box.x1; ++u)
-        if (sm.mask(u, v)) rec.missing += missing(depth(u, v), plane_depth(u, v));
+        if (sm.mask(u, v)) rec.missing += lost(depth(u, v), z_at(u, v), params);
     if (rec.inlier_ratio < params.min_inlier_ratio) {
       done(fmt::format("the depth around the mask is not planar ({:.2f} on the plane)", rec.inlier_ratio));
       continue;
@@ -209,8 +218,8 @@ ReflectiveFillResult fill_reflective_depth(DepthImage& depth, std::span<const Se
     for (int v = box.y0; v <= box.y1; ++v)
       for (int u = box.x0; u <= box.x1; ++u) {
         if (!sm.mask(u, v)) continue;
-        const float z = plane_depth(u, v);
-        if (z > 0.0f && missing(depth(u, v), z)) {
+        const float z = z_at(u, v);
+        if (z > 0.0f && lost(depth(u, v), z, params)) {
           depth(u, v) = z;
           out.filled(u, v) = 1;
           ++rec.filled;
@@ -239,11 +248,8 @@ std::vector<FillRegion> fill_regions(const ReflectiveFillResult& result, std::sp
     for (int v = 0; v < K.height; v += 2)
       for (int u = 0; u < K.width; u += 2) {
         if (!mask(u, v)) continue;
-        const Eigen::Vector3f r((float(u) - K.cx) / K.fx, (float(v) - K.cy) / K.fy, 1.0f);
-        const float nd = m.plane.n.dot(r);
-        if (!(nd < 0.0f)) continue;
-        const float z = -m.plane.d / nd;
-        if (z > 0.0f && std::isfinite(z)) points.push_back(T_wc * (z * r));
+        const float z = plane_depth(m.plane, K, u, v, 0.0f, std::numeric_limits<float>::max());
+        if (z > 0.0f) points.push_back(T_wc * (z * pixel_ray(K, u, v)));
       }
     if (points.empty()) continue;
     FillRegion region;
@@ -288,14 +294,10 @@ ReflectiveFillResult fill_from_regions(DepthImage& depth, std::span<const FillRe
     };
     for (int v = 0; v < h; ++v)
       for (int u = 0; u < w; ++u) {
-        const Eigen::Vector3f r((float(u) - K.cx) / K.fx, (float(v) - K.cy) / K.fy, 1.0f);
-        const float nd = rec.plane.n.dot(r);
-        if (!(-nd >= cos_max * r.norm())) continue;
-        const float z = -rec.plane.d / nd;
-        if (!(z > 0.0f && z <= params.max_depth) || !on_footprint(T_wc * (z * r))) continue;
+        const float z = plane_depth(rec.plane, K, u, v, cos_max, params.max_depth);
+        if (!(z > 0.0f) || !on_footprint(T_wc * (z * pixel_ray(K, u, v)))) continue;
         ++rec.pixels;
-        const float d = depth(u, v);
-        if (!(d > 0.0f) || !std::isfinite(d) || d > z + params.tolerance(z)) {
+        if (lost(depth(u, v), z, params)) {
           ++rec.missing;
           depth(u, v) = z;
           out.filled(u, v) = 1;
