@@ -11,7 +11,6 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
-#include <optional>
 #include <chrono>
 #include <optional>
 #include <set>
@@ -104,11 +103,13 @@ PlaneEvalReport run_plane_eval(const PlaneEvalOptions& options) {
     float exposure_gain = 1.0f;  // as the session estimates it (core/planes/exposure_gain.h)
     // The depth the sensor lost on reflective masks, filled as the session does (planes.fill) with
     // the first cue's masks, which every cue's segmentation of this frame then sees.
+    const SemanticCue& cue = identifiers[0].cue();
+    const bool fill = options.params.fill.enabled && !cue.every_plane_is_candidate() &&
+                      (identify || cue.masks_with_every_frame());
     LabelImage labels;
-    const bool cue_masks = identify || identifiers[0].cue().masks_with_every_frame();
-    if (needs_labels && (identify || cue_masks)) labels = io::read_synth_labels(options.dataset, k);
+    if (needs_labels && (identify || fill)) labels = io::read_synth_labels(options.dataset, k);
     std::optional<std::vector<SemanticMask>> masks;
-    if (options.params.fill.enabled && !identifiers[0].cue().every_plane_is_candidate() && cue_masks) {
+    if (fill) {
       IdentificationFrame f{&frame.depth, &frame.color, needs_labels ? &labels : nullptr, K, T_wc, int64_t(k)};
       masks = identifiers[0].semantic_masks(f);
       const auto t0 = std::chrono::steady_clock::now();

@@ -113,14 +113,10 @@ bool fit_ring_plane(const std::vector<RingPoint>& ring, const ReflectiveFillPara
   return true;
 }
 
-Eigen::Vector3f pixel_ray(const Intrinsics& K, int u, int v) {  // z = 1
-  return {(float(u) - K.cx) / K.fx, (float(v) - K.cy) / K.fy, 1.0f};
-}
-
 // Depth along the optical axis at which pixel (u, v)'s ray meets `plane` (camera frame) on its
 // camera-facing side; 0 when it does not, meets it more obliquely than cos_max, or beyond max_depth.
 float plane_depth(const Plane& plane, const Intrinsics& K, int u, int v, float cos_max, float max_depth) {
-  const Eigen::Vector3f d = pixel_ray(K, u, v);
+  const Eigen::Vector3f d = K.unproject(float(u), float(v), 1.0f);
   const float nd = plane.n.dot(d);  // < 0 when the ray meets the camera-facing side
   if (!(-nd >= cos_max * d.norm())) return 0.0f;
   const float z = -plane.d / nd;
@@ -176,7 +172,7 @@ ReflectiveFillResult fill_reflective_depth(DepthImage& depth, std::span<const Se
       for (int u = std::max(0, box.x0 - r); u <= std::min(w - 1, box.x1 + r); ++u) {
         const float z = depth(u, v);
         if (!grown(u, v) || sm.mask(u, v) || !(z > 0.0f) || !std::isfinite(z)) continue;
-        ring.push_back({z * pixel_ray(K, u, v), u, v, params.tolerance(z)});
+        ring.push_back({z * K.unproject(float(u), float(v), 1.0f), u, v, params.tolerance(z)});
       }
     rec.ring_points = int64_t(ring.size());
     if (rec.ring_points < params.min_ring_points) {
@@ -249,7 +245,7 @@ std::vector<FillRegion> fill_regions(const ReflectiveFillResult& result, std::sp
       for (int u = 0; u < K.width; u += 2) {
         if (!mask(u, v)) continue;
         const float z = plane_depth(m.plane, K, u, v, 0.0f, std::numeric_limits<float>::max());
-        if (z > 0.0f) points.push_back(T_wc * (z * pixel_ray(K, u, v)));
+        if (z > 0.0f) points.push_back(T_wc * (z * K.unproject(float(u), float(v), 1.0f)));
       }
     if (points.empty()) continue;
     FillRegion region;
@@ -295,7 +291,7 @@ ReflectiveFillResult fill_from_regions(DepthImage& depth, std::span<const FillRe
     for (int v = 0; v < h; ++v)
       for (int u = 0; u < w; ++u) {
         const float z = plane_depth(rec.plane, K, u, v, cos_max, params.max_depth);
-        if (!(z > 0.0f) || !on_footprint(T_wc * (z * pixel_ray(K, u, v)))) continue;
+        if (!(z > 0.0f) || !on_footprint(T_wc * (z * K.unproject(float(u), float(v), 1.0f)))) continue;
         ++rec.pixels;
         if (lost(depth(u, v), z, params)) {
           ++rec.missing;

@@ -352,7 +352,7 @@ FrameReport Session::process(const SessionFrame& frame) {
   if (report.state != TrackingState::Lost) {
     DeviceImage<int32_t> plane_ids;
     DeviceImage<uint8_t> mask;
-    const bool identify = identify_due;
+    const bool identify = identify_due;  // (decided before tracking: the fill asks for its masks)
     if (identify) s.identify(frame, *D_k, masks ? &*masks : nullptr, report.T_wc, report, plane_ids, mask);
     const auto tf = Clock::now();
     {
