@@ -78,9 +78,7 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 
 ReflectiveFillParams IdentificationParams::fill_params() const {
   ReflectiveFillParams f = fill;
-  f.noise_a = segmentation.noise_a;
-  f.noise_b = segmentation.noise_b;
-  f.noise_z0 = segmentation.noise_z0;
+  f.noise = segmentation.noise;
   return f;
 }
 

@@ -23,7 +23,7 @@ void PlaneSegmentationParams::validate() const {
   need(cell_size == 0 || cell_size >= 3, "cell_size must be 0 (auto) or >= 3");
   need(min_valid_ratio > 0 && min_valid_ratio <= 1, "min_valid_ratio must be in (0, 1]");
   need(sigma_min > 0 && sigma_k >= 0, "sigma_min must be > 0 and sigma_k >= 0");
-  need(noise_a >= 0 && noise_b >= 0 && planar_sigmas > 0, "noise_a, noise_b must be >= 0 and planar_sigmas > 0");
+  need(noise.valid() && planar_sigmas > 0, "noise_a, noise_b must be finite and >= 0 and planar_sigmas > 0");
   need(jump_ratio > 0, "jump_ratio must be > 0");
   need(histogram_bins >= 1, "histogram_bins must be >= 1");
   need(grow_angle_deg > 0 && grow_angle_deg < 90, "grow_angle_deg must be in (0, 90)");
@@ -38,7 +38,7 @@ std::string PlaneSegmentationParams::to_string() const {
   return fmt::format("cell {} px, noise {} + {} (z - {})^2 m, planar {} noise sigma, "
                      "sigma max({} m, {} z^2), grow {} deg / {} sigma, merge {} deg / {} m, "
                      "refine {} sigma, min region {} cells",
-                     cell_size, noise_a, noise_b, noise_z0, planar_sigmas, sigma_min, sigma_k,
+                     cell_size, noise.a, noise.b, noise.z0, planar_sigmas, sigma_min, sigma_k,
                      grow_angle_deg, grow_distance_sigmas, merge_angle_deg,
                      merge_distance, refine_distance_sigmas, min_region_cells);
 }

@@ -11,6 +11,7 @@
 //     cells) are dropped and the pixels refined again.
 // Output: the per-pixel local plane map and the plane parameters (n, b) refitted to the pixels.
 #include "core/common/camera.h"
+#include "core/common/depth_noise_model.h"
 #include "core/common/image.h"
 #include "core/planes/plane_types.h"
 
@@ -25,7 +26,7 @@ struct PlaneSegmentationParams {
   // Sensor axial noise σ_n(z) = a + b (z − z0)², metres: Kinect v1 (Nguyen, Izadi & Lovell 2012),
   // the class of RGB-D sensors the paper and CAPE target. It bounds the cell fit (RMS < planar_sigmas
   // σ_n, or σ(z) below when larger) and widens the pixel refinement to refine_distance_sigmas σ_n.
-  float noise_a = 0.0012f, noise_b = 0.0019f, noise_z0 = 0.4f;
+  DepthNoiseModel noise;
   float planar_sigmas = 2.0f;
   float sigma_min = 0.002f;          // σ_min, metres: floor of the distance scale σ(z) below
   float sigma_k = 0.001f;            // k_σ, 1/m: σ(z) = max(σ_min, k_σ z²): growing and merging distances
@@ -44,7 +45,7 @@ struct PlaneSegmentationParams {
   void validate() const;             // throws std::invalid_argument naming the bad field
   std::string to_string() const;
   float sigma(float z) const { return std::max(sigma_min, sigma_k * z * z); }
-  float noise_sigma(float z) const { return noise_a + noise_b * (z - noise_z0) * (z - noise_z0); }
+  float noise_sigma(float z) const { return noise.sigma(z); }
   float planar_rms(float z) const { return std::max(sigma(z), planar_sigmas * noise_sigma(z)); }
   // Coplanarity of two regions (step 3, and LocalPlane::same_plane_distance): centroid-to-plane distance.
   float merge_tolerance(float z) const { return std::max(merge_distance, 3.0f * sigma(z)); }

@@ -15,8 +15,7 @@
 namespace rrg {
 
 float ReflectiveFillParams::tolerance(float z) const {
-  const float sigma = noise_a + noise_b * (z - noise_z0) * (z - noise_z0);
-  return std::max(min_tolerance, inlier_sigmas * sigma);
+  return std::max(min_tolerance, inlier_sigmas * noise.sigma(z));
 }
 
 void ReflectiveFillParams::validate() const {
@@ -30,8 +29,7 @@ void ReflectiveFillParams::validate() const {
   if (min_ring_points < 3) fail("min_ring_points", "must be >= 3");
   if (!(inlier_sigmas > 0.0f) || !std::isfinite(inlier_sigmas)) fail("inlier_sigmas", "must be > 0");
   if (!(min_tolerance > 0.0f) || !std::isfinite(min_tolerance)) fail("min_tolerance", "must be > 0");
-  if (!(noise_a >= 0.0f && noise_b >= 0.0f) || !std::isfinite(noise_a + noise_b + noise_z0))
-    fail("noise_a/noise_b", "must be finite and >= 0");
+  if (!noise.valid()) fail("noise", "(planes.segmentation.noise_a/b/z0) must be finite, a and b >= 0");
   if (!(min_inlier_ratio > 0.0f && min_inlier_ratio <= 1.0f)) fail("min_inlier_ratio", "must be in (0, 1]");
   if (min_sides < 1 || min_sides > 4) fail("min_sides", "must be 1..4");
   if (!(min_side_share >= 0.0f && min_side_share <= 0.25f)) fail("min_side_share", "must be in [0, 0.25]");

@@ -10,6 +10,7 @@
 // frame) keep their depth. A departure from the paper, which assumes depth on its planes
 // (docs/planes.md "Mirrors without depth").
 #include "core/common/camera.h"
+#include "core/common/depth_noise_model.h"
 #include "core/common/image.h"
 #include "core/planes/plane_footprint.h"
 #include "core/planes/plane_types.h"
@@ -42,7 +43,7 @@ struct ReflectiveFillParams {
   // same tolerance decides "behind the plane".
   float inlier_sigmas = 3.0f;
   float min_tolerance = 0.01f;
-  float noise_a = 0.0012f, noise_b = 0.0019f, noise_z0 = 0.4f;
+  DepthNoiseModel noise;         // IdentificationParams::fill_params() sets segmentation's
   float min_inlier_ratio = 0.6f;  // of the valid ring points
   // The inliers must lie on at least min_sides of the four sides of the mask's bounding box, each
   // holding min_side_share of them. Two sides, adjacent (an L) or opposite (two strips), fix a

@@ -219,9 +219,9 @@ std::vector<ConfigField> config_fields(SessionConfig& c) {
   t.i("planes.fill.min_sides", c.planes.fill.min_sides, "sides of the mask's bounding box that plane must be seen on");
   t.i("planes.vote.windows", c.planes.vote.windows, "vote history, windows");
   t.i("planes.vote.min_reflective", c.planes.vote.min_reflective, "windows needed to accept");
-  t.f("planes.segmentation.noise_a", c.planes.segmentation.noise_a, "sensor noise σ_n = a + b (z − z0)², a in metres");
-  t.f("planes.segmentation.noise_b", c.planes.segmentation.noise_b, "sensor noise σ_n, b in 1/m");
-  t.f("planes.segmentation.noise_z0", c.planes.segmentation.noise_z0, "sensor noise σ_n, z0 in metres");
+  t.f("planes.segmentation.noise_a", c.planes.segmentation.noise.a, "sensor noise σ_n = a + b (z − z0)², a in metres");
+  t.f("planes.segmentation.noise_b", c.planes.segmentation.noise.b, "sensor noise σ_n, b in 1/m");
+  t.f("planes.segmentation.noise_z0", c.planes.segmentation.noise.z0, "sensor noise σ_n, z0 in metres");
   t.f("planes.segmentation.planar_sigmas", c.planes.segmentation.planar_sigmas, "cell fit RMS bound in σ_n");
   t.f("planes.segmentation.sigma_min", c.planes.segmentation.sigma_min, "σ_min, metres");
   t.f("planes.segmentation.sigma_k", c.planes.segmentation.sigma_k, "k_σ, 1/m");

@@ -1,5 +1,6 @@
 #include "core/synth/depth_noise.h"
 
+#include "core/common/depth_noise_model.h"
 #include "core/synth/hash.h"
 
 #include <cmath>
@@ -7,7 +8,7 @@
 
 namespace rrg::synth {
 
-float kinect_sigma(float z) { return 0.0012f + 0.0019f * (z - 0.4f) * (z - 0.4f); }
+float kinect_sigma(float z) { return DepthNoiseModel{}.sigma(z); }
 
 void apply_depth_noise(DepthImage& depth, const Image<uint16_t>& material, const Scene& scene,
                        const DepthNoiseParams& params, uint32_t frame, uint32_t seed) {

@@ -19,7 +19,7 @@ struct DepthNoiseParams {
   float mirror_f0 = 0.5f;
 };
 
-// Kinect-like axial noise standard deviation at depth z (metres).
+// Kinect-like axial noise standard deviation at depth z (metres): DepthNoiseModel{}.sigma(z).
 float kinect_sigma(float z);
 
 // Applies the model in place. material holds material index + 1 per pixel (RenderOutput::material).

@@ -2,6 +2,7 @@
 // against the plane's analytic depth; surroundings that are not one plane, or seen on too few
 // sides, leave the frame as it is.
 #include "core/planes/reflective_fill.h"
+#include "core/planes/plane_identification.h"
 
 #include <gtest/gtest.h>
 
@@ -179,6 +180,19 @@ TEST(ReflectiveFill, BadInputIsRejected) {
   }
   MaskImage filled(4, 4, 0);
   EXPECT_THROW(copy_filled_depth(depth, filled, depth), std::invalid_argument);
+}
+
+// The fill's inlier band comes from segmentation's sensor model (one config, one formula):
+// max(1 cm, 3 σ_n(z)) with σ_n = a + b (z − z0)².
+TEST(ReflectiveFill, TheInlierBandUsesSegmentationsNoiseModel) {
+  IdentificationParams p;
+  p.segmentation.noise = {0.002f, 0.01f, 0.5f};
+  const ReflectiveFillParams f = p.fill_params();
+  EXPECT_FLOAT_EQ(f.tolerance(4.5f), 3.0f * (0.002f + 0.01f * 16.0f));
+  EXPECT_FLOAT_EQ(f.tolerance(0.5f), 0.01f);  // 3 σ_n = 6 mm < the 1 cm floor
+  EXPECT_FLOAT_EQ(p.segmentation.noise_sigma(4.5f), 0.002f + 0.01f * 16.0f);
+  p.segmentation.noise.b = -1.0f;
+  EXPECT_THROW(p.validate(), std::invalid_argument);
 }
 
 TEST(ReflectiveFill, TheSameFillCopiesIntoAnotherDepth) {
