@@ -139,6 +139,7 @@ void ManagedSession::run_one(Item& item) {
     r.set_map_version(report.map_version);
     r.set_fused(report.fused);
     r.set_note(report.note);
+    r.set_filled_pixels(uint32_t(report.filled_pixels));
     if (!item.frame.render.empty()) {
       const SessionView view = session_->render(session_->config().K, report.T_wc);
       *r.mutable_view() = encode_view(view, item.frame.render);

@@ -54,6 +54,7 @@ struct SessionRun {
   io::Trajectory trajectory;
   std::string timings_csv;
   std::string error;
+  uint64_t filled_frames = 0, filled_pixels = 0;  // the reflective fill (planes.fill)
 };
 
 // Create, retried on RESOURCE_EXHAUSTED (a full server: session count or memory budget) after a
@@ -171,6 +172,10 @@ void run_stream(const StreamCmdOptions& o) {
           if (r.dropped()) return;
           const Eigen::Isometry3f T = service::from_proto(r.pose());
           run.trajectory.push_back({r.timestamp(), T.cast<double>()});
+          if (r.filled_pixels() > 0) {
+            ++run.filled_frames;
+            run.filled_pixels += r.filled_pixels();
+          }
           const auto& t = r.timings();
           run.timings_csv += fmt::format("{},{},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f}\n", r.id(),
                                          service::to_string(r.state()), rtt, t.queue(), t.decode(), t.total(), t.icp(),
@@ -213,6 +218,9 @@ void run_stream(const StreamCmdOptions& o) {
                 "p50 %.1f ms, p99 %.1f ms (window %d)\n", run.handle.id.c_str(), s.server.empty() ? "?" : s.server.c_str(), s.sent, s.round_trip_ms.size(),
                 s.dropped, s.rejected, double(s.round_trip_ms.size()) / s.wall_s, percentile(s.round_trip_ms, 0.5),
                 percentile(s.round_trip_ms, 0.99), o.window);
+    if (run.filled_frames > 0)
+      std::printf("session %s: reflective fill: %llu frames, %llu depth pixels filled on reflective masks\n",
+                  run.handle.id.c_str(), (unsigned long long)run.filled_frames, (unsigned long long)run.filled_pixels);
     if (!gt.empty() && run.trajectory.size() >= 3) {
       const auto m = eval::evaluate_trajectory(run.trajectory, gt);
       std::printf("session %s: ATE RMSE %.3f cm (rigid SE(3) Umeyama alignment, %zu poses; unaligned %.3f cm)\n",

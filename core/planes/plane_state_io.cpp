@@ -1,6 +1,7 @@
 #include "core/planes/plane_state_io.h"
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 #include <stdexcept>
 
@@ -24,6 +25,49 @@ Box2 get_box(io::ByteReader& r) {
 
 }  // namespace
 
+void PlaneStateIo::put_footprint(io::ByteWriter& w, const Footprint& f) {
+  put_v3(w, f.basis_.origin), put_v3(w, f.basis_.u), put_v3(w, f.basis_.v);
+  w.put(f.cell_);
+  put_box(w, f.box_);
+  std::vector<uint64_t> cells(f.cells_.begin(), f.cells_.end());
+  std::sort(cells.begin(), cells.end());  // the same bytes for the same footprint
+  w.put_vector(cells);
+}
+
+Footprint PlaneStateIo::get_footprint(io::ByteReader& r) {
+  Footprint f;
+  f.basis_.origin = get_v3(r), f.basis_.u = get_v3(r), f.basis_.v = get_v3(r);
+  f.cell_ = r.get<float>();
+  if (!(f.cell_ > 0.0f)) throw std::runtime_error(r.what() + ": footprint cell size is not > 0");
+  f.box_ = get_box(r);
+  for (uint64_t c : r.get_vector<uint64_t>()) f.cells_.insert(c);
+  return f;
+}
+
+void PlaneStateIo::write_fill_regions(io::ByteWriter& w, std::span<const FillRegion> regions) {
+  w.put<uint64_t>(regions.size());
+  for (const FillRegion& g : regions) {
+    w.put_string(g.label);
+    put_v3(w, g.plane.n);
+    w.put(g.plane.d);
+    put_footprint(w, g.footprint);
+  }
+}
+
+std::vector<FillRegion> PlaneStateIo::read_fill_regions(io::ByteReader& r) {
+  const auto n = r.get<uint64_t>();
+  if (n > r.remaining()) throw std::runtime_error(r.what() + ": corrupt fill region count");
+  std::vector<FillRegion> regions(n);
+  for (FillRegion& g : regions) {
+    g.label = r.get_string();
+    g.plane.n = get_v3(r);
+    g.plane.d = r.get<float>();
+    if (!(std::abs(g.plane.n.norm() - 1.0f) < 1e-3f)) throw std::runtime_error(r.what() + ": fill region normal is not unit");
+    g.footprint = get_footprint(r);
+  }
+  return regions;
+}
+
 void PlaneStateIo::write(io::ByteWriter& w, const PlaneIdentifier& id) {
   w.put<uint32_t>(2);  // format version (2: GlobalPlane::apart)
   w.put<int64_t>(id.window_);
@@ -36,13 +80,7 @@ void PlaneStateIo::write(io::ByteWriter& w, const PlaneIdentifier& id) {
     put_v3(w, g.centroid);
     w.put<int64_t>(g.moments.count_);
     for (double s : g.moments.s_) w.put(s);
-    const Footprint& f = g.footprint;
-    put_v3(w, f.basis_.origin), put_v3(w, f.basis_.u), put_v3(w, f.basis_.v);
-    w.put(f.cell_);
-    put_box(w, f.box_);
-    std::vector<uint64_t> cells(f.cells_.begin(), f.cells_.end());
-    std::sort(cells.begin(), cells.end());
-    w.put_vector(cells);
+    put_footprint(w, g.footprint);
     w.put<int64_t>(g.first_seen), w.put<int64_t>(g.last_seen);
     w.put<int32_t>(g.observations);
     w.put<uint8_t>(g.alive);
@@ -78,11 +116,7 @@ void PlaneStateIo::read(io::ByteReader& r, PlaneIdentifier& id) {
     g.centroid = get_v3(r);
     g.moments.count_ = r.get<int64_t>();
     for (double& s : g.moments.s_) s = r.get<double>();
-    Footprint& f = g.footprint;
-    f.basis_.origin = get_v3(r), f.basis_.u = get_v3(r), f.basis_.v = get_v3(r);
-    f.cell_ = r.get<float>();
-    f.box_ = get_box(r);
-    for (uint64_t c : r.get_vector<uint64_t>()) f.cells_.insert(c);
+    g.footprint = get_footprint(r);
     g.first_seen = r.get<int64_t>(), g.last_seen = r.get<int64_t>();
     g.observations = r.get<int32_t>();
     g.alive = r.get<uint8_t>() != 0;

@@ -3,7 +3,7 @@
 // Payload v2 = the continuation section (its length, then core/slam/snapshot_continuation.h: the
 // tracker's ORB keyframes and motion state, the mapper's step counter, stored keyframes, frames
 // since the last step and both Adam states, the session's fused frames not yet handed to the
-// mapper), followed by the v1 payload:
+// mapper, the reflective fill's carried surfaces), followed by the v1 payload:
 //   config (YAML text + category table), schedule counters and the last pose, trajectory and
 //   per-frame reports, the TSDF (its own versioned file format, embedded), base and reflection
 //   Gaussians, the plane identifier's state, the accepted reflective planes and the id remap.
@@ -136,6 +136,7 @@ void Session::save(const std::filesystem::path& file) const {
       c.pending.push_back(CompactFrame::from(s.pending[i]));
       c.pending_keyframe.push_back(s.pending_keyframe[i] ? 1 : 0);
     }
+    c.fill_regions = s.fill_regions;
     const std::vector<uint8_t> section = write_continuation(c);
     continuation_bytes = section.size();
     stored_frames = c.mapper.frames.size() + c.pending.size();
@@ -278,6 +279,7 @@ std::unique_ptr<Session> Session::load(const std::filesystem::path& file, std::u
       s.pending_keyframe.push_back(c.pending_keyframe[i] != 0);
     }
     s.tracker_keyframes = s.tracker.keyframes().size();
+    s.fill_regions = std::move(c.fill_regions);
   } else {
     spdlog::info("{}: format v1 has no keyframes, motion or optimiser state; tracking resumes from the last pose "
                  "and mapping from the frames that follow", what);

@@ -1,6 +1,7 @@
 #include "core/slam/snapshot_continuation.h"
 
 #include "core/io/rvl.h"
+#include "core/planes/plane_state_io.h"
 #include "core/tracking/tracker_state_io.h"
 
 #include <zstd.h>
@@ -12,7 +13,7 @@
 namespace rrg {
 namespace {
 
-constexpr uint32_t kSectionVersion = 1;
+constexpr uint32_t kSectionVersion = 2;  // 1: no fill regions (still read)
 constexpr int kZstdLevel = 3;
 
 // raw size, then one zstd frame
@@ -139,13 +140,14 @@ std::vector<uint8_t> write_continuation(const ContinuationState& s) {
   w.put<uint64_t>(s.pending.size());
   for (const CompactFrame& f : s.pending) put_frame(w, f);
   w.put_vector(s.pending_keyframe);
+  PlaneStateIo::write_fill_regions(w, s.fill_regions);
   return std::move(w.bytes());
 }
 
 ContinuationState read_continuation(std::span<const uint8_t> bytes, const std::string& what) {
   io::ByteReader r(bytes, what + " (continuation)");
   const auto version = r.get<uint32_t>();
-  if (version != kSectionVersion)
+  if (version != 1 && version != kSectionVersion)
     throw std::runtime_error(r.what() + ": unsupported section version " + std::to_string(version));
   ContinuationState s;
   s.tracker = read_tracker_state(r);
@@ -162,6 +164,7 @@ ContinuationState read_continuation(std::span<const uint8_t> bytes, const std::s
   s.pending_keyframe = r.get_vector<uint8_t>();
   if (s.pending_keyframe.size() != s.pending.size())
     throw std::runtime_error(r.what() + ": pending frames and keyframe flags differ in number");
+  if (version >= 2) s.fill_regions = PlaneStateIo::read_fill_regions(r);
   if (r.remaining() != 0) throw std::runtime_error(r.what() + ": " + std::to_string(r.remaining()) + " trailing bytes");
   return s;
 }

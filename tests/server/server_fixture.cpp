@@ -122,33 +122,50 @@ const fs::path& sequence_dir() {
   return dir;
 }
 
-v1::CreateSessionRequest create_request() {
-  const auto ds = io::open_dataset(sequence_dir());
+v1::CreateSessionRequest create_request() { return create_request(sequence_dir()); }
+
+v1::CreateSessionRequest create_request(const fs::path& dir) {
+  const auto ds = io::open_dataset(dir);
   v1::CreateSessionRequest r;
   *r.mutable_intrinsics() = service::to_proto(ds->intrinsics());
   r.set_depth_scale(ds->depth_scale());
   r.set_name("test");
   for (const auto& [k, v] : kTestConfig) (*r.mutable_config())[k] = v;
   (*r.mutable_config())["semantics"] = "labels";
-  for (const auto& [id, name] : read_category_table(io::synth_scene_file(sequence_dir(), "categories.json")).names)
+  for (const auto& [id, name] : read_category_table(io::synth_scene_file(dir, "categories.json")).names)
     (*r.mutable_categories())[id] = name;
   return r;
 }
 
 const std::vector<v1::Frame>& wire_frames() {
-  static const std::vector<v1::Frame> frames = [] {
-    const auto ds = io::open_dataset(sequence_dir());
-    std::vector<v1::Frame> v;
-    for (size_t i = 0; i < ds->size(); ++i) {
-      const io::Frame f = ds->load(i);
-      std::optional<Eigen::Isometry3f> prior;
-      if (i == 0 && f.T_wc_gt) prior = f.T_wc_gt->cast<float>();
-      v.push_back(service::encode_frame(i, f.timestamp, f.color, f.depth, ds->depth_scale(), {},
-                                        io::read_synth_labels(sequence_dir(), i), prior));
-    }
-    return v;
-  }();
+  static const std::vector<v1::Frame> frames = encode_sequence(sequence_dir());
   return frames;
+}
+
+std::vector<v1::Frame> encode_sequence(const fs::path& dir) {
+  const auto ds = io::open_dataset(dir);
+  std::vector<v1::Frame> v;
+  for (size_t i = 0; i < ds->size(); ++i) {
+    const io::Frame f = ds->load(i);
+    std::optional<Eigen::Isometry3f> prior;
+    if (i == 0 && f.T_wc_gt) prior = f.T_wc_gt->cast<float>();
+    v.push_back(service::encode_frame(i, f.timestamp, f.color, f.depth, ds->depth_scale(), {},
+                                      io::read_synth_labels(dir, i), prior));
+  }
+  return v;
+}
+
+std::vector<FrameReport> process_in_process(const v1::CreateSessionRequest& req, const std::vector<v1::Frame>& frames,
+                                            std::unique_ptr<Session>* keep) {
+  SessionConfig c;
+  c.K = service::from_proto(req.intrinsics());
+  for (const auto& [k, v] : req.config()) set_config_value(c, k, v);
+  for (const auto& [id, name] : req.categories()) c.categories[uint16_t(id)] = name;
+  auto session = std::make_unique<Session>(c);
+  std::vector<FrameReport> reports;
+  for (const auto& f : frames) reports.push_back(session->process(server::decode_frame(f, c.K, req.depth_scale()).frame));
+  if (keep) *keep = std::move(session);
+  return reports;
 }
 
 namespace {
@@ -158,18 +175,9 @@ struct Reference {
 };
 const Reference& reference() {
   static const Reference ref = [] {
-    const v1::CreateSessionRequest req = create_request();
-    SessionConfig c;
-    c.K = service::from_proto(req.intrinsics());
-    for (const auto& [k, v] : req.config()) set_config_value(c, k, v);
-    for (const auto& [id, name] : req.categories()) c.categories[uint16_t(id)] = name;
     Reference r;
-    r.session = std::make_unique<Session>(c);
-    for (const auto& f : wire_frames()) {
-      const server::DecodedFrame d = server::decode_frame(f, c.K, req.depth_scale());
-      const FrameReport rep = r.session->process(d.frame);
+    for (const FrameReport& rep : process_in_process(create_request(), wire_frames(), &r.session))
       r.trajectory.push_back({rep.timestamp, rep.T_wc.cast<double>()});
-    }
     return r;
   }();
   return ref;

@@ -41,9 +41,15 @@ const std::filesystem::path& sequence_dir();
 // Create request for the sequence (camera, depth scale, label categories) with the test config:
 // sync = true (deterministic), 1 cm voxels and short mapping so the tests stay fast on 2 cores.
 v1::CreateSessionRequest create_request();
+v1::CreateSessionRequest create_request(const std::filesystem::path& dir);  // for another synth sequence
 // The sequence's frames as sent on the wire (PNG colour, RVL+zstd depth, PNG labels, frame 0
 // with its ground-truth pose prior); n = 0: all.
 const std::vector<v1::Frame>& wire_frames();
+std::vector<v1::Frame> encode_sequence(const std::filesystem::path& dir);  // the same for another sequence
+// An in-process Session made from a create request, fed `frames` through the server's decoder:
+// its report of every frame (and the session itself in *keep when given).
+std::vector<FrameReport> process_in_process(const v1::CreateSessionRequest& req, const std::vector<v1::Frame>& frames,
+                                            std::unique_ptr<Session>* keep = nullptr);
 // The in-process Session's trajectory on the same frames (decoded by the server's own decoder).
 const io::Trajectory& reference_trajectory();
 // The in-process Session after those frames (for counts).

@@ -12,6 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <atomic>
+#include <mutex>
 #include <thread>
 
 namespace rrg::test {
@@ -42,6 +43,7 @@ void expect_reference_trajectory(const std::vector<v1::FrameResult>& results, si
     const Eigen::Isometry3d& R = ref[r.id()].T_wc;
     EXPECT_LT((T.translation() - R.translation()).norm(), 1e-4);
     EXPECT_LT(Eigen::AngleAxisd(T.rotation().transpose() * R.rotation()).angle(), 1e-4);
+    EXPECT_EQ(r.filled_pixels(), 0u);  // the glass has depth in this sequence: nothing to fill
   }
 }
 
@@ -55,6 +57,42 @@ TEST(Service, StreamGivesTheInProcessSessionsTrajectory) {
   EXPECT_EQ(info.frames(), wire_frames().size());
   EXPECT_EQ(info.frames_dropped(), 0u);
   EXPECT_EQ(info.map_version(), reference_session().status().map_version);
+  c.close(h);
+}
+
+// A sensor that loses the mirror's depth: the session fills it from the wall around the mirror
+// (labels sent with the frames) and each FrameResult says how many pixels, as the in-process
+// Session does on the same frames.
+TEST(Service, FramesReportTheDepthFilledOnALostMirror) {
+  TempDir dir("rrg-lost-mirror");
+  const auto synth = run_rrg("synth --preset mirror_room --frames 6 --width 160 --height 120 --novel 0 --threads 2 "
+                             "--mirror-depth invalid --out " + dir.path().string());
+  ASSERT_EQ(synth.exit_code, 0) << synth.output;
+  const v1::CreateSessionRequest req = create_request(dir.path());
+  const std::vector<v1::Frame> frames = encode_sequence(dir.path());
+  const std::vector<FrameReport> expected = process_in_process(req, frames);
+  auto c = shared_server().client();
+  const auto created = c.create(req);
+  const SessionHandle h{created.session_id(), created.token()};
+  std::vector<v1::FrameResult> results;
+  std::mutex m;
+  size_t next = 0;
+  const auto sum = c.stream(
+      h, [&]() -> std::optional<v1::Frame> { return next < frames.size() ? std::optional(frames[next++]) : std::nullopt; },
+      [&](const v1::FrameResult& r, double) {
+        std::lock_guard lock(m);
+        results.push_back(r);
+      },
+      service::StreamOptions{});
+  ASSERT_TRUE(sum.status.ok()) << sum.status.error_message();
+  ASSERT_EQ(results.size(), frames.size());
+  uint64_t filled = 0;
+  for (const auto& r : results) {
+    ASSERT_FALSE(r.has_error()) << r.error().message();
+    EXPECT_EQ(int64_t(r.filled_pixels()), expected[r.id()].filled_pixels) << "frame " << r.id();
+    filled += r.filled_pixels();
+  }
+  EXPECT_GT(filled, 1000u) << "nothing filled on a mirror without depth";
   c.close(h);
 }
 

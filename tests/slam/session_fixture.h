@@ -16,6 +16,21 @@
 
 namespace rrg::test {
 
+// The labels cue as a `remote` one behaves: masks on identification frames only (every N_p = 10).
+class IdentificationFrameLabels final : public SemanticCue {
+ public:
+  explicit IdentificationFrameLabels(std::unique_ptr<SemanticCue> labels) : labels_(std::move(labels)) {}
+  std::string name() const override { return "remote"; }
+  std::vector<SemanticMask> segment(const SemanticFrame& f) override {
+    ++calls;
+    return labels_->segment(f);
+  }
+  int calls = 0;
+
+ private:
+  std::unique_ptr<SemanticCue> labels_;
+};
+
 // Suite is the derived fixture (CRTP), so each suite owns its folder. Frames is the sequence length.
 template <class Suite, size_t Frames>
 class SynthSessionTest : public ::testing::Test {
@@ -43,6 +58,12 @@ class SynthSessionTest : public ::testing::Test {
     c.sync = true;
     c.mapping.iterations = 5;
     return c;
+  }
+  static CategoryTable categories() { return read_category_table(io::synth_scene_file(root(), "categories.json")); }
+  static uint16_t category_id(const std::string& name) {  // 0 when the scene has no such category
+    for (const auto& [id, n] : categories().names)
+      if (n == name) return id;
+    return 0;
   }
   // Frame i with its labels; with its ground-truth pose when with_pose.
   static SessionFrame frame(const io::Dataset& d, size_t i, bool with_pose) {

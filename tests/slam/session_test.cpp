@@ -16,12 +16,6 @@ namespace {
 
 class SessionTest : public test::SynthSessionTest<SessionTest, 24> {
  protected:
-  static CategoryTable categories() { return read_category_table(io::synth_scene_file(root(), "categories.json")); }
-  static uint16_t category_id(const std::string& name) {
-    for (const auto& [id, n] : categories().names)
-      if (n == name) return id;
-    return 0;
-  }
   static SessionConfig config(const io::Dataset& d) { return base_config(d); }
   static void run(Session& s, const io::Dataset& d, size_t n, bool poses_always) {
     for (size_t i = 0; i < n; ++i) s.process(frame(d, i, poses_always || i == 0));
@@ -131,20 +125,6 @@ TEST_F(SessionTest, ALostMirrorIsFilledFromTheWallAroundIt) {
     }
 }
 
-// The labels cue as a `remote` one behaves: masks on identification frames only (every N_p = 10).
-class IdentificationFrameLabels final : public SemanticCue {
- public:
-  explicit IdentificationFrameLabels(std::unique_ptr<SemanticCue> labels) : labels_(std::move(labels)) {}
-  std::string name() const override { return "remote"; }
-  std::vector<SemanticMask> segment(const SemanticFrame& f) override {
-    ++calls;
-    return labels_->segment(f);
-  }
-  int calls = 0;
-
- private:
-  std::unique_ptr<SemanticCue> labels_;
-};
 
 // A sensor that sees through the mirror, with masks on identification frames only (the `remote`
 // cue): frames 0 and 10 fill from their masks, the 18 frames between from the surface those fills
@@ -158,8 +138,8 @@ TEST_F(SessionTest, FramesWithoutMasksFillFromTheLastFill) {
     SessionConfig c = config(*d);
     c.gt_poses = true;
     c.planes.fill.carry = carry;
-    auto cue = std::make_unique<IdentificationFrameLabels>(make_label_semantics(categories(), default_prompts()));
-    IdentificationFrameLabels* probe_cue = cue.get();
+    auto cue = std::make_unique<test::IdentificationFrameLabels>(make_label_semantics(categories(), default_prompts()));
+    test::IdentificationFrameLabels* probe_cue = cue.get();
     Session s(c, std::move(cue));
     std::vector<int64_t> filled(20, 0);
     for (size_t i = 0; i < 20; ++i) {

@@ -130,6 +130,49 @@ TEST_F(SnapshotTest, ALoadedSessionContinuesLikeTheUninterruptedOne) {
   EXPECT_TRUE(ma.vertices == mb.vertices);
 }
 
+// The reflective fill's carried surfaces are in the snapshot. A sensor that sees through the mirror
+// and masks on identification frames only (N_p = 10, as the `remote` cue gives them): frames 1-9
+// fill from the surface frame 0 left. Saved after frame 4, the loaded session fills frames 5-9 as
+// the uninterrupted one does (without the surfaces it would fill none and fuse the room behind).
+TEST_F(SnapshotTest, CarriedFillSurfacesSurviveALoad) {
+  const auto d = io::open_dataset(root());
+  test::TempDir dir("snap-fill");
+  const uint16_t mirror_id = category_id("mirror");
+  ASSERT_NE(mirror_id, 0);
+  SessionConfig c = base_config(*d);
+  c.gt_poses = true;
+  c.plane_period = 10;
+  const auto cue = [] {
+    return std::make_unique<test::IdentificationFrameLabels>(make_label_semantics(categories(), default_prompts()));
+  };
+  const auto seen_through = [&](size_t i) {
+    SessionFrame f = SynthSessionTest::frame(*d, i, true);
+    for (size_t k = 0; k < f.depth.size(); ++k)
+      if ((*f.labels)[k] == mirror_id && f.depth[k] > 0.0f) f.depth[k] += 1.5f;
+    return f;
+  };
+  constexpr size_t kAt = 5, kEnd = 10;
+  Session whole(c, cue());
+  std::vector<int64_t> expected;
+  for (size_t i = 0; i < kEnd; ++i) expected.push_back(whole.process(seen_through(i)).filled_pixels);
+  for (size_t i = kAt; i < kEnd; ++i) ASSERT_GT(expected[i], 0) << "frame " << i << " fills from the carried surface";
+  std::unique_ptr<Session> loaded;
+  {
+    Session first(c, cue());
+    for (size_t i = 0; i < kAt; ++i) first.process(seen_through(i));
+    first.save(dir / "s.rrgs");
+    loaded = Session::load(dir / "s.rrgs", cue());
+  }
+  for (size_t i = kAt; i < kEnd; ++i)
+    EXPECT_EQ(loaded->process(seen_through(i)).filled_pixels, expected[i]) << "frame " << i;
+  whole.finish();
+  loaded->finish();
+  const auto ta = whole.trajectory(), tb = loaded->trajectory();
+  ASSERT_EQ(ta.size(), tb.size());
+  for (size_t i = 0; i < ta.size(); ++i) EXPECT_TRUE(ta[i].T_wc.isApprox(tb[i].T_wc, 0.0)) << "frame " << i;
+  EXPECT_EQ(whole.status().tsdf_blocks, loaded->status().tsdf_blocks);
+}
+
 TEST_F(SnapshotTest, VersionOneFilesStillLoadAndContinue) {
   const auto d = io::open_dataset(root());
   test::TempDir dir("snap-v1");
