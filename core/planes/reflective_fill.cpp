@@ -182,18 +182,23 @@ ReflectiveFillResult fill_reflective_depth(DepthImage& depth, std::span<const Se
       continue;
     }
     rec.fitted = true;
-    // Inliers, and the sides of the box they lie on (the one each is farthest outside of).
+    const auto z_at = [&](int u, int v) { return plane_depth(rec.plane, K, u, v, cos_max, params.max_depth); };
+    // Ring points on the plane, in front of it (occluders) or behind it; the sides of the box the
+    // inliers lie on (the one each is farthest outside of).
     std::array<int64_t, 4> side{0, 0, 0, 0};
     int64_t inliers = 0;
     for (const RingPoint& p : ring) {
-      if (!(std::abs(rec.plane.signed_distance(p.p)) < p.tol)) continue;
-      ++inliers;
-      const std::array<int, 4> out_by{box.x0 - p.u, p.u - box.x1, box.y0 - p.v, p.v - box.y1};
-      ++side[size_t(std::max_element(out_by.begin(), out_by.end()) - out_by.begin())];
+      const float sd = rec.plane.signed_distance(p.p);  // > 0 on the camera's side
+      if (std::abs(sd) < p.tol) {
+        ++inliers;
+        const std::array<int, 4> out_by{box.x0 - p.u, p.u - box.x1, box.y0 - p.v, p.v - box.y1};
+        ++side[size_t(std::max_element(out_by.begin(), out_by.end()) - out_by.begin())];
+      } else {
+        ++(sd > 0.0f ? rec.in_front : rec.behind);
+      }
     }
-    rec.inlier_ratio = float(inliers) / float(ring.size());
+    rec.inlier_ratio = float(inliers) / float(rec.ring_points);
     for (const int64_t s : side) rec.sides += s > 0 && float(s) >= params.min_side_share * float(inliers);
-    const auto z_at = [&](int u, int v) { return plane_depth(rec.plane, K, u, v, cos_max, params.max_depth); };
     for (int v = box.y0; v <= box.y1; ++v)
       for (int u = box.x0; u <= box.x1; ++u)
         if (sm.mask(u, v)) rec.missing += lost(depth(u, v), z_at(u, v), params);
@@ -209,6 +214,34 @@ ReflectiveFillResult fill_reflective_depth(DepthImage& depth, std::span<const Se
       done("the sensor kept the surface");
       continue;
     }
+    // The glass beyond the mask (a mask that stops short of it): ring pixels with depth behind the
+    // plane, reached from the mask through such pixels (4-neighbours).
+    if (params.grow_beyond_mask) {
+      const auto glass = [&](int u, int v) {
+        const float d = depth(u, v);
+        if (!grown(u, v) || sm.mask(u, v) || !(d > 0.0f) || !std::isfinite(d)) return false;
+        const float z = z_at(u, v);
+        return z > 0.0f && lost(d, z, params);
+      };
+      MaskImage seen(w, h, 0);
+      std::vector<int32_t> stack;
+      const auto visit = [&](int u, int v) {
+        if (u < 0 || v < 0 || u >= w || v >= h || seen(u, v) || !glass(u, v)) return;
+        seen(u, v) = 1;
+        stack.push_back(v * w + u);
+      };
+      for (int v = box.y0; v <= box.y1; ++v)
+        for (int u = box.x0; u <= box.x1; ++u)
+          if (sm.mask(u, v)) visit(u - 1, v), visit(u + 1, v), visit(u, v - 1), visit(u, v + 1);
+      while (!stack.empty()) {
+        const int32_t i = stack.back();
+        stack.pop_back();
+        rec.beyond.push_back(i);
+        const int u = i % w, v = i / w;
+        visit(u - 1, v), visit(u + 1, v), visit(u, v - 1), visit(u, v + 1);
+      }
+      std::sort(rec.beyond.begin(), rec.beyond.end());
+    }
     for (int v = box.y0; v <= box.y1; ++v)
       for (int u = box.x0; u <= box.x1; ++u) {
         if (!sm.mask(u, v)) continue;
@@ -219,6 +252,11 @@ ReflectiveFillResult fill_reflective_depth(DepthImage& depth, std::span<const Se
           ++rec.filled;
         }
       }
+    for (const int32_t i : rec.beyond) {
+      depth[size_t(i)] = z_at(i % w, i / w);
+      out.filled[size_t(i)] = 1;
+      ++rec.filled;
+    }
     out.pixels += rec.filled;
     if (rec.filled == 0) rec.skipped = "no pixel faces the plane";
     out.masks.push_back(std::move(rec));
@@ -238,13 +276,17 @@ std::vector<FillRegion> fill_regions(const ReflectiveFillResult& result, std::sp
       throw std::invalid_argument("fill_regions: mask and intrinsics sizes differ");
     // The mask's pixels on the plane, world frame, every second one per axis: two pixels span less
     // than a 5 cm cell at indoor ranges, and the footprint is read with a one-cell dilation.
+    // The glass filled beyond the mask as well, every pixel (a strip a few pixels wide).
     std::vector<Eigen::Vector3f> points;
+    const auto add = [&](int u, int v) {
+      const float z = plane_depth(m.plane, K, u, v, 0.0f, std::numeric_limits<float>::max());
+      if (z > 0.0f) points.push_back(T_wc * (z * K.unproject(float(u), float(v), 1.0f)));
+    };
     for (int v = 0; v < K.height; v += 2)
-      for (int u = 0; u < K.width; u += 2) {
-        if (!mask(u, v)) continue;
-        const float z = plane_depth(m.plane, K, u, v, 0.0f, std::numeric_limits<float>::max());
-        if (z > 0.0f) points.push_back(T_wc * (z * K.unproject(float(u), float(v), 1.0f)));
-      }
+      for (int u = 0; u < K.width; u += 2)
+        if (mask(u, v)) add(u, v);
+    for (const int32_t i : m.beyond)
+      if (i >= 0 && i < K.width * K.height) add(i % K.width, i / K.width);
     if (points.empty()) continue;
     FillRegion region;
     region.label = m.label;

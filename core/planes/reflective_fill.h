@@ -44,13 +44,21 @@ struct ReflectiveFillParams {
   float inlier_sigmas = 3.0f;
   float min_tolerance = 0.01f;
   DepthNoiseModel noise;         // IdentificationParams::fill_params() sets segmentation's
-  float min_inlier_ratio = 0.6f;  // of the valid ring points
+  // Planarity: at least this share of the valid ring points on the plane. (Counting occluders in
+  // front of the plane and the glass beyond a short mask as neither for nor against it, tried, let
+  // wrong planes through: the office's and living_room's floor masks were filled from furniture.)
+  float min_inlier_ratio = 0.6f;
   // The inliers must lie on at least min_sides of the four sides of the mask's bounding box, each
   // holding min_side_share of them. Two sides, adjacent (an L) or opposite (two strips), fix a
   // plane across the mask; one strip leaves it free to tilt about the strip, and a fill from it
   // would be an extrapolation. Two, not three: a mirror cut by the image's border is seen on two.
   int min_sides = 2;
   float min_side_share = 0.05f;
+  // A segmenter's mask may stop short of the glass. Once a mask is filled, the ring pixels whose
+  // depth lies behind the plane and that connect to the mask through such pixels (4-neighbours,
+  // within the ring) are the glass beyond it, and are filled as well. Pixels without depth there are
+  // left as they are (nothing is fused from them either way).
+  bool grow_beyond_mask = true;
   float max_ray_angle_deg = 80.0f;  // no fill where a ray meets the plane more obliquely
   int ransac_iterations = 128;      // deterministic (fixed seed)
   float max_depth = 10.0f;          // filled depths beyond this are left out, metres
@@ -65,8 +73,11 @@ struct ReflectiveFillMask {
   size_t mask_index = 0;      // in the masks given (fill_reflective_depth)
   int64_t pixels = 0;         // mask pixels
   int64_t missing = 0;        // without depth or behind the plane (0 when no plane was fitted)
-  int64_t filled = 0;         // pixels written
+  int64_t filled = 0;         // pixels written (the mask's and beyond)
+  std::vector<int32_t> beyond;  // pixels filled outside the mask (v · width + u): glass it stopped short of
   int64_t ring_points = 0;    // valid ring pixels
+  int64_t in_front = 0;       // ring points in front of the plane (occluders)
+  int64_t behind = 0;         // ring points behind it
   float inlier_ratio = 0.0f;  // of the ring points, on the plane
   int sides = 0;              // sides of the mask's bounding box the inliers cover
   Plane plane;                // camera frame, facing the camera (d > 0), when fitted

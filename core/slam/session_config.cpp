@@ -216,6 +216,8 @@ std::vector<ConfigField> config_fields(SessionConfig& c) {
   t.f("planes.fill.min_missing", c.planes.fill.min_missing,
       "fill a mask when this share of its pixels has no depth or depth behind that plane");
   t.f("planes.fill.min_inlier_ratio", c.planes.fill.min_inlier_ratio, "share of the ring around the mask on one plane");
+  t.b("planes.fill.grow_beyond_mask", c.planes.fill.grow_beyond_mask,
+      "fill the glass a mask stops short of: ring pixels behind the plane that connect to the mask");
   t.i("planes.fill.min_sides", c.planes.fill.min_sides, "sides of the mask's bounding box that plane must be seen on");
   t.i("planes.vote.windows", c.planes.vote.windows, "vote history, windows");
   t.i("planes.vote.min_reflective", c.planes.vote.min_reflective, "windows needed to accept");

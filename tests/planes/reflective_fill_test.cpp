@@ -108,9 +108,60 @@ TEST(ReflectiveFill, SurroundingsThatAreNotOnePlaneLeaveTheHole) {
   const ReflectiveFillResult r = fill_reflective_depth(depth, std::span(&mirror, 1), kK, ReflectiveFillParams{});
   ASSERT_EQ(r.masks.size(), 1u);
   EXPECT_EQ(r.masks[0].filled, 0);
-  EXPECT_NE(r.masks[0].skipped.find("not planar"), std::string::npos) << r.masks[0].skipped;
+  EXPECT_NE(r.masks[0].skipped.find("not planar"), std::string::npos) << r.masks[0].skipped << " ratio " << r.masks[0].inlier_ratio << " front " << r.masks[0].in_front << " behind " << r.masks[0].behind << " beyond " << r.masks[0].beyond.size() << " ring " << r.masks[0].ring_points;
   EXPECT_EQ(r.pixels, 0);
   for (size_t i = 0; i < depth.size(); ++i) ASSERT_EQ(depth[i], before[i]);
+}
+
+// A segmenter's mask 2 px short of the glass, on a sensor that sees through it: the strip of glass
+// between the mask and the wall is filled as well (the mirrored room there would otherwise be fused
+// behind the wall); without the growth it keeps the depth seen through.
+TEST(ReflectiveFill, AMaskShortOfTheGlassFillsTheGlassBeyondIt) {
+  DepthImage seen = wall_image();
+  for (int v = 20; v <= 100; ++v)
+    for (int u = 40; u <= 120; ++u) seen(u, v) = wall_depth(u, v) * 1.6f;  // the mirrored room behind the glass
+  const SemanticMask mask = rect_mask(42, 22, 118, 98);
+  ReflectiveFillParams params;
+  params.min_ring_px = 8;  // 2 px of glass, then 6 px of wall
+  DepthImage depth = seen;
+  const ReflectiveFillResult r = fill_reflective_depth(depth, std::span(&mask, 1), kK, params);
+  ASSERT_EQ(r.masks.size(), 1u);
+  const ReflectiveFillMask& m = r.masks[0];
+  EXPECT_EQ(m.skipped, "");
+  EXPECT_EQ(int64_t(m.beyond.size()), 81 * 81 - 77 * 77);
+  EXPECT_EQ(m.filled, 81 * 81);
+  for (int v = 0; v < kK.height; ++v)
+    for (int u = 0; u < kK.width; ++u) {
+      const bool glass = u >= 40 && u <= 120 && v >= 20 && v <= 100;
+      EXPECT_EQ(r.filled(u, v), glass ? 1 : 0) << u << "," << v;
+      EXPECT_NEAR(depth(u, v), wall_depth(u, v), 1e-4f) << u << "," << v;
+    }
+  params.grow_beyond_mask = false;
+  DepthImage kept = seen;
+  const ReflectiveFillResult r0 = fill_reflective_depth(kept, std::span(&mask, 1), kK, params);
+  EXPECT_EQ(r0.pixels, 77 * 77);
+  EXPECT_TRUE(r0.masks[0].beyond.empty());
+  EXPECT_EQ(kept(40, 60), seen(40, 60)) << "the strip keeps the depth seen through";
+}
+
+// The growth is only the glass connected to the mask: depth behind the plane beside the mask, past a
+// strip of wall (a doorway beside the mirror), is not grown into, and counts against the plane.
+TEST(ReflectiveFill, BehindThePlaneBesideTheMaskIsNotGlass) {
+  ReflectiveFillParams params;
+  params.min_ring_px = 10;
+  const SemanticMask mask = rect_mask(50, 30, 110, 90);
+  DepthImage door = wall_with_hole(50, 30, 110, 90);
+  for (int v = 20; v <= 100; ++v)
+    for (int u = 113; u <= 120; ++u) door(u, v) = wall_depth(u, v) + 1.0f;
+  const DepthImage before = door;
+  const ReflectiveFillResult rd = fill_reflective_depth(door, std::span(&mask, 1), kK, params);
+  ASSERT_EQ(rd.masks.size(), 1u);
+  EXPECT_EQ(rd.masks[0].skipped, "");
+  EXPECT_TRUE(rd.masks[0].beyond.empty());
+  EXPECT_GT(rd.masks[0].behind, 0);
+  EXPECT_LT(rd.masks[0].inlier_ratio, 0.9f);
+  for (int v = 20; v <= 100; ++v)
+    for (int u = 113; u <= 120; ++u) ASSERT_EQ(door(u, v), before(u, v)) << "the doorway keeps its depth";
 }
 
 TEST(ReflectiveFill, APlaneSeenOnOneSideIsNotExtrapolated) {
