@@ -113,7 +113,9 @@ PlaneEvalReport run_plane_eval(const PlaneEvalOptions& options) {
       IdentificationFrame f{&frame.depth, &frame.color, needs_labels ? &labels : nullptr, K, T_wc, int64_t(k)};
       masks = identifiers[0].semantic_masks(f);
       const auto t0 = std::chrono::steady_clock::now();
-      report.filled_pixels += fill_reflective_depth(frame.depth, *masks, K, options.params.fill_params()).pixels;
+      const ReflectiveFillResult filled = fill_reflective_depth(frame.depth, *masks, K, options.params.fill_params());
+      add_glass_beyond(filled, *masks);  // as the session's identification frames do
+      report.filled_pixels += filled.pixels;
       fill_ms += ms_since(t0);
       ++fills;
     }

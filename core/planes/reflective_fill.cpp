@@ -264,6 +264,15 @@ ReflectiveFillResult fill_reflective_depth(DepthImage& depth, std::span<const Se
   return out;
 }
 
+void add_glass_beyond(const ReflectiveFillResult& result, std::span<SemanticMask> masks) {
+  for (const ReflectiveFillMask& m : result.masks) {
+    if (m.beyond.empty()) continue;
+    if (m.mask_index >= masks.size() || m.beyond.back() >= int32_t(masks[m.mask_index].mask.size()))
+      throw std::invalid_argument("add_glass_beyond: the masks are not those of the fill");
+    for (const int32_t i : m.beyond) masks[m.mask_index].mask[size_t(i)] = 1;
+  }
+}
+
 std::vector<FillRegion> fill_regions(const ReflectiveFillResult& result, std::span<const SemanticMask> masks,
                                      const Intrinsics& K, const Eigen::Isometry3f& T_wc, float cell) {
   if (!(cell > 0.0f)) throw std::invalid_argument("fill_regions: cell must be > 0");

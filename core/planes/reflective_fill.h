@@ -96,6 +96,11 @@ struct ReflectiveFillResult {
 ReflectiveFillResult fill_reflective_depth(DepthImage& depth, std::span<const SemanticMask> masks, const Intrinsics& K,
                                            const ReflectiveFillParams& params);
 
+// Adds to each mask the glass its fill found beyond it (ReflectiveFillMask::beyond), so that the
+// identification that reads these masks counts it in the predicted reflection mask (R). `masks` are
+// the masks the fill was given; throws std::invalid_argument when they are not.
+void add_glass_beyond(const ReflectiveFillResult& result, std::span<SemanticMask> masks);
+
 // What a fill leaves for the frames that get no masks (the `remote` cue's between identification
 // frames): each filled mask's surface in the world frame, its plane and the footprint (a grid of
 // `cell` metres on the plane, plane_footprint.h) of the mask's pixels on it.

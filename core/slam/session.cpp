@@ -355,10 +355,7 @@ FrameReport Session::process(const SessionFrame& frame) {
     const bool identify = identify_due;  // (decided before tracking: the fill asks for its masks)
     // The glass a mask stopped short of, which the fill found beyond it, is the mirror's too: its
     // reflections belong in the predicted reflection mask (R), not in the base, nor under ORB.
-    if (identify && mask_fill && masks)
-      for (const ReflectiveFillMask& m : mask_fill->masks)
-        if (m.mask_index < masks->size())
-          for (const int32_t i : m.beyond) (*masks)[m.mask_index].mask[size_t(i)] = 1;
+    if (identify && mask_fill && masks) add_glass_beyond(*mask_fill, *masks);
     if (identify) s.identify(frame, *D_k, masks ? &*masks : nullptr, report.T_wc, report, plane_ids, mask);
     const auto tf = Clock::now();
     {

@@ -105,8 +105,8 @@ struct Session::Impl {
   io::Trajectory trajectory;
   std::vector<FrameReport> reports;
   std::vector<ReflectivePlane> reflective;
-  // The last fill's surfaces (world frame), for frames without masks (planes.fill). Not part of
-  // snapshots: a loaded session regains them at its next frame with masks.
+  // The last fill's surfaces (world frame), for frames without masks (planes.fill). Saved in
+  // snapshots (the continuation section).
   std::vector<FillRegion> fill_regions;
   MappingSummary mapping;
   std::atomic<uint64_t> map_version{0};

@@ -136,6 +136,13 @@ TEST(ReflectiveFill, AMaskShortOfTheGlassFillsTheGlassBeyondIt) {
       EXPECT_EQ(r.filled(u, v), glass ? 1 : 0) << u << "," << v;
       EXPECT_NEAR(depth(u, v), wall_depth(u, v), 1e-4f) << u << "," << v;
     }
+  // The mask then takes in the glass beyond it (for identification's R): the whole glass.
+  SemanticMask whole = mask;
+  add_glass_beyond(r, std::span(&whole, 1));
+  for (int v = 0; v < kK.height; ++v)
+    for (int u = 0; u < kK.width; ++u)
+      ASSERT_EQ(whole.mask(u, v), u >= 40 && u <= 120 && v >= 20 && v <= 100 ? 1 : 0) << u << "," << v;
+  EXPECT_THROW(add_glass_beyond(r, std::span<SemanticMask>{}), std::invalid_argument);
   params.grow_beyond_mask = false;
   DepthImage kept = seen;
   const ReflectiveFillResult r0 = fill_reflective_depth(kept, std::span(&mask, 1), kK, params);
