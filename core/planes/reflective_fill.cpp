@@ -33,6 +33,7 @@ void ReflectiveFillParams::validate() const {
   if (!(min_inlier_ratio > 0.0f && min_inlier_ratio <= 1.0f)) fail("min_inlier_ratio", "must be in (0, 1]");
   if (min_sides < 1 || min_sides > 4) fail("min_sides", "must be 1..4");
   if (!(min_side_share >= 0.0f && min_side_share <= 0.25f)) fail("min_side_share", "must be in [0, 0.25]");
+  if (!(min_region_share >= 0.0f && min_region_share < 1.0f)) fail("min_region_share", "must be in [0, 1)");
   if (!(max_ray_angle_deg > 0.0f && max_ray_angle_deg < 90.0f)) fail("max_ray_angle_deg", "must be in (0, 90)");
   if (ransac_iterations < 1) fail("ransac_iterations", "must be >= 1");
   if (!(max_depth > 0.0f) || !std::isfinite(max_depth)) fail("max_depth", "must be > 0");
@@ -70,6 +71,25 @@ MaskImage dilate(const MaskImage& mask, const Box& b, int r) {
     }
   }
   return out;
+}
+
+// The bounding box of a mask's pixels (empty, x1 < x0, when it has none) and their count.
+Box mask_box(const MaskImage& mask, int64_t& pixels) {
+  Box box{mask.width(), mask.height(), -1, -1};
+  pixels = 0;
+  for (int v = 0; v < mask.height(); ++v)
+    for (int u = 0; u < mask.width(); ++u)
+      if (mask(u, v)) {
+        ++pixels;
+        box = {std::min(box.x0, u), std::min(box.y0, v), std::max(box.x1, u), std::max(box.y1, v)};
+      }
+  return box;
+}
+
+// The ring's width around a mask of bounding box `box`: max(min_ring_px, ring_fraction · diagonal).
+int ring_width(const Box& box, const ReflectiveFillParams& params) {
+  const float diagonal = std::hypot(float(box.x1 - box.x0 + 1), float(box.y1 - box.y0 + 1));
+  return std::max(params.min_ring_px, int(std::lround(params.ring_fraction * diagonal)));
 }
 
 struct RingPoint {
@@ -126,6 +146,59 @@ bool lost(float d, float z, const ReflectiveFillParams& params) {
   return !(d > 0.0f) || !std::isfinite(d) || (z > 0.0f && d > z + params.tolerance(z));
 }
 
+// Writes the plane rec.plane into the mask's lost pixels, and into the glass beyond the mask (a
+// mask that stops short of it: ring pixels (`grown` less the mask) with depth behind the plane,
+// reached from the mask through such pixels, 4-neighbours) when params.grow_beyond_mask; records
+// them in rec (filled, beyond) and in `filled`.
+void fill_mask_from_plane(DepthImage& depth, const MaskImage& mask, const Box& box, const MaskImage& grown,
+                          const Intrinsics& K, const ReflectiveFillParams& params, ReflectiveFillMask& rec,
+                          MaskImage& filled) {
+  const int w = depth.width(), h = depth.height();
+  const float cos_max = std::cos(params.max_ray_angle_deg * float(M_PI) / 180.0f);
+  const auto z_at = [&](int u, int v) { return plane_depth(rec.plane, K, u, v, cos_max, params.max_depth); };
+  if (params.grow_beyond_mask) {
+    const auto glass = [&](int u, int v) {
+      const float d = depth(u, v);
+      if (!grown(u, v) || mask(u, v) || !(d > 0.0f) || !std::isfinite(d)) return false;
+      const float z = z_at(u, v);
+      return z > 0.0f && lost(d, z, params);
+    };
+    MaskImage seen(w, h, 0);
+    std::vector<int32_t> stack;
+    const auto visit = [&](int u, int v) {
+      if (u < 0 || v < 0 || u >= w || v >= h || seen(u, v) || !glass(u, v)) return;
+      seen(u, v) = 1;
+      stack.push_back(v * w + u);
+    };
+    for (int v = box.y0; v <= box.y1; ++v)
+      for (int u = box.x0; u <= box.x1; ++u)
+        if (mask(u, v)) visit(u - 1, v), visit(u + 1, v), visit(u, v - 1), visit(u, v + 1);
+    while (!stack.empty()) {
+      const int32_t i = stack.back();
+      stack.pop_back();
+      rec.beyond.push_back(i);
+      const int u = i % w, v = i / w;
+      visit(u - 1, v), visit(u + 1, v), visit(u, v - 1), visit(u, v + 1);
+    }
+    std::sort(rec.beyond.begin(), rec.beyond.end());
+  }
+  for (int v = box.y0; v <= box.y1; ++v)
+    for (int u = box.x0; u <= box.x1; ++u) {
+      if (!mask(u, v)) continue;
+      const float z = z_at(u, v);
+      if (z > 0.0f && lost(depth(u, v), z, params)) {
+        depth(u, v) = z;
+        filled(u, v) = 1;
+        ++rec.filled;
+      }
+    }
+  for (const int32_t i : rec.beyond) {
+    depth[size_t(i)] = z_at(i % w, i / w);
+    filled[size_t(i)] = 1;
+    ++rec.filled;
+  }
+}
+
 }  // namespace
 
 ReflectiveFillResult fill_reflective_depth(DepthImage& depth, std::span<const SemanticMask> masks, const Intrinsics& K,
@@ -146,13 +219,7 @@ ReflectiveFillResult fill_reflective_depth(DepthImage& depth, std::span<const Se
     ReflectiveFillMask rec;
     rec.label = sm.label;
     rec.mask_index = size_t(&sm - masks.data());
-    Box box{w, h, -1, -1};
-    for (int v = 0; v < h; ++v)
-      for (int u = 0; u < w; ++u)
-        if (sm.mask(u, v)) {
-          ++rec.pixels;
-          box = {std::min(box.x0, u), std::min(box.y0, v), std::max(box.x1, u), std::max(box.y1, v)};
-        }
+    const Box box = mask_box(sm.mask, rec.pixels);
     const auto done = [&](std::string why) {
       rec.skipped = std::move(why);
       out.masks.push_back(std::move(rec));
@@ -162,8 +229,7 @@ ReflectiveFillResult fill_reflective_depth(DepthImage& depth, std::span<const Se
       continue;
     }
     // The ring and its valid depth, back-projected.
-    const float diagonal = std::hypot(float(box.x1 - box.x0 + 1), float(box.y1 - box.y0 + 1));
-    const int r = std::max(params.min_ring_px, int(std::lround(params.ring_fraction * diagonal)));
+    const int r = ring_width(box, params);
     const MaskImage grown = dilate(sm.mask, box, r);
     std::vector<RingPoint> ring;
     for (int v = std::max(0, box.y0 - r); v <= std::min(h - 1, box.y1 + r); ++v)
@@ -214,49 +280,7 @@ ReflectiveFillResult fill_reflective_depth(DepthImage& depth, std::span<const Se
       done("the sensor kept the surface");
       continue;
     }
-    // The glass beyond the mask (a mask that stops short of it): ring pixels with depth behind the
-    // plane, reached from the mask through such pixels (4-neighbours).
-    if (params.grow_beyond_mask) {
-      const auto glass = [&](int u, int v) {
-        const float d = depth(u, v);
-        if (!grown(u, v) || sm.mask(u, v) || !(d > 0.0f) || !std::isfinite(d)) return false;
-        const float z = z_at(u, v);
-        return z > 0.0f && lost(d, z, params);
-      };
-      MaskImage seen(w, h, 0);
-      std::vector<int32_t> stack;
-      const auto visit = [&](int u, int v) {
-        if (u < 0 || v < 0 || u >= w || v >= h || seen(u, v) || !glass(u, v)) return;
-        seen(u, v) = 1;
-        stack.push_back(v * w + u);
-      };
-      for (int v = box.y0; v <= box.y1; ++v)
-        for (int u = box.x0; u <= box.x1; ++u)
-          if (sm.mask(u, v)) visit(u - 1, v), visit(u + 1, v), visit(u, v - 1), visit(u, v + 1);
-      while (!stack.empty()) {
-        const int32_t i = stack.back();
-        stack.pop_back();
-        rec.beyond.push_back(i);
-        const int u = i % w, v = i / w;
-        visit(u - 1, v), visit(u + 1, v), visit(u, v - 1), visit(u, v + 1);
-      }
-      std::sort(rec.beyond.begin(), rec.beyond.end());
-    }
-    for (int v = box.y0; v <= box.y1; ++v)
-      for (int u = box.x0; u <= box.x1; ++u) {
-        if (!sm.mask(u, v)) continue;
-        const float z = z_at(u, v);
-        if (z > 0.0f && lost(depth(u, v), z, params)) {
-          depth(u, v) = z;
-          out.filled(u, v) = 1;
-          ++rec.filled;
-        }
-      }
-    for (const int32_t i : rec.beyond) {
-      depth[size_t(i)] = z_at(i % w, i / w);
-      out.filled[size_t(i)] = 1;
-      ++rec.filled;
-    }
+    fill_mask_from_plane(depth, sm.mask, box, grown, K, params, rec, out.filled);
     out.pixels += rec.filled;
     if (rec.filled == 0) rec.skipped = "no pixel faces the plane";
     out.masks.push_back(std::move(rec));
@@ -278,7 +302,7 @@ std::vector<FillRegion> fill_regions(const ReflectiveFillResult& result, std::sp
   if (!(cell > 0.0f)) throw std::invalid_argument("fill_regions: cell must be > 0");
   std::vector<FillRegion> out;
   for (const ReflectiveFillMask& m : result.masks) {
-    if (m.filled == 0 || !m.fitted) continue;
+    if (m.filled == 0 || !m.fitted || m.from_region) continue;
     if (m.mask_index >= masks.size()) throw std::invalid_argument("fill_regions: the masks are not those of the fill");
     const MaskImage& mask = masks[m.mask_index].mask;
     if (mask.width() != K.width || mask.height() != K.height)
@@ -307,6 +331,47 @@ std::vector<FillRegion> fill_regions(const ReflectiveFillResult& result, std::sp
   return out;
 }
 
+namespace {
+
+// Whether p_w (on the footprint's plane) falls in the footprint dilated by one cell.
+bool on_dilated_footprint(const Footprint& fp, const Eigen::Vector3f& p_w) {
+  const Eigen::Vector2f q = fp.basis().project(p_w) / fp.cell_size();
+  const int i = int(std::floor(q.x())), j = int(std::floor(q.y()));
+  for (int di = -1; di <= 1; ++di)
+    for (int dj = -1; dj <= 1; ++dj)
+      if (fp.contains_cell(i + di, j + dj)) return true;
+  return false;
+}
+
+// The centre of a footprint's bounding box, in the world frame (on its plane).
+Eigen::Vector3f footprint_centre(const Footprint& fp) {
+  const Eigen::Vector2f c = 0.5f * (fp.box().min + fp.box().max);
+  return fp.basis().origin + c.x() * fp.basis().u + c.y() * fp.basis().v;
+}
+
+}  // namespace
+
+bool same_surface(const FillRegion& carried, const FillRegion& fresh, const RegionMatch& match) {
+  if (carried.label != fresh.label) return false;
+  if (carried.footprint.cells() == 0 || fresh.footprint.cells() == 0) return false;
+  if (carried.plane.n.dot(fresh.plane.n) < std::cos(match.max_normal_angle_deg * float(M_PI) / 180.0f)) return false;
+  if (std::abs(carried.plane.signed_distance(footprint_centre(fresh.footprint))) > match.max_distance ||
+      std::abs(fresh.plane.signed_distance(footprint_centre(carried.footprint))) > match.max_distance)
+    return false;
+  Footprint on_fresh(fresh.footprint.basis(), fresh.footprint.cell_size());
+  on_fresh.merge(carried.footprint);
+  return fresh.footprint.overlap_ratio(on_fresh) > match.min_overlap;
+}
+
+size_t merge_fill_regions(std::vector<FillRegion>& carried, std::vector<FillRegion> fresh, const RegionMatch& match) {
+  std::erase_if(carried, [&](const FillRegion& old) {
+    return std::any_of(fresh.begin(), fresh.end(), [&](const FillRegion& f) { return same_surface(old, f, match); });
+  });
+  const size_t kept = carried.size();
+  for (FillRegion& f : fresh) carried.push_back(std::move(f));
+  return kept;
+}
+
 ReflectiveFillResult fill_from_regions(DepthImage& depth, std::span<const FillRegion> regions, const Intrinsics& K,
                                        const Eigen::Isometry3f& T_wc, const ReflectiveFillParams& params) {
   params.validate();
@@ -327,16 +392,7 @@ ReflectiveFillResult fill_from_regions(DepthImage& depth, std::span<const FillRe
       out.masks.push_back(std::move(rec));
       continue;
     }
-    const Footprint& fp = region.footprint;
-    const float cell = fp.cell_size();
-    const auto on_footprint = [&](const Eigen::Vector3f& p_w) {  // dilated by one cell
-      const Eigen::Vector2f q = fp.basis().project(p_w) / cell;
-      const int i = int(std::floor(q.x())), j = int(std::floor(q.y()));
-      for (int di = -1; di <= 1; ++di)
-        for (int dj = -1; dj <= 1; ++dj)
-          if (fp.contains_cell(i + di, j + dj)) return true;
-      return false;
-    };
+    const auto on_footprint = [&](const Eigen::Vector3f& p_w) { return on_dilated_footprint(region.footprint, p_w); };
     for (int v = 0; v < h; ++v)
       for (int u = 0; u < w; ++u) {
         const float z = plane_depth(rec.plane, K, u, v, cos_max, params.max_depth);
@@ -353,6 +409,72 @@ ReflectiveFillResult fill_from_regions(DepthImage& depth, std::span<const FillRe
     out.masks.push_back(std::move(rec));
   }
   return out;
+}
+
+int64_t fill_failed_masks_from_regions(DepthImage& depth, ReflectiveFillResult& result,
+                                       std::span<const SemanticMask> masks, std::span<const FillRegion> regions,
+                                       const Intrinsics& K, const Eigen::Isometry3f& T_wc,
+                                       const ReflectiveFillParams& params, MaskImage& written) {
+  params.validate();
+  const int w = depth.width(), h = depth.height();
+  if (K.width != w || K.height != h || !written.same_size(depth) || !result.filled.same_size(depth))
+    throw std::invalid_argument(fmt::format("fill_failed_masks_from_regions: intrinsics {}x{}, depth {}x{}, masks {}x{} and "
+                                            "{}x{} differ", K.width, K.height, w, h, written.width(), written.height(),
+                                            result.filled.width(), result.filled.height()));
+  const float cos_max = std::cos(params.max_ray_angle_deg * float(M_PI) / 180.0f);
+  const Eigen::Isometry3f T_cw = T_wc.inverse();
+  int64_t total = 0;
+  for (ReflectiveFillMask& rec : result.masks) {
+    if (rec.filled > 0) continue;
+    if (rec.mask_index >= masks.size() || !masks[rec.mask_index].mask.same_size(depth))
+      throw std::invalid_argument("fill_failed_masks_from_regions: the masks are not those of the fill");
+    const MaskImage& mask = masks[rec.mask_index].mask;
+    int64_t pixels = 0;
+    const Box box = mask_box(mask, pixels);
+    if (pixels < params.min_mask_pixels) continue;
+    // The region of the mask's label that the most of its pixels (every second one per axis) meet.
+    const FillRegion* best = nullptr;
+    int64_t best_on = 0, sampled = 0;
+    for (const FillRegion& region : regions) {
+      if (region.label != rec.label) continue;
+      const Plane pc = region.plane.transformed(T_cw);
+      if (!(pc.d > 0.0f)) continue;  // seen from behind
+      int64_t on = 0;
+      sampled = 0;
+      for (int v = box.y0; v <= box.y1; v += 2)
+        for (int u = box.x0; u <= box.x1; u += 2) {
+          if (!mask(u, v)) continue;
+          ++sampled;
+          const float z = plane_depth(pc, K, u, v, cos_max, params.max_depth);
+          on += z > 0.0f && on_dilated_footprint(region.footprint, T_wc * (z * K.unproject(float(u), float(v), 1.0f)));
+        }
+      if (on > best_on) {
+        best_on = on;
+        best = &region;
+      }
+    }
+    if (!best || float(best_on) <= params.min_region_share * float(sampled)) continue;
+    ReflectiveFillMask from_region = rec;
+    from_region.plane = best->plane.transformed(T_cw);
+    from_region.fitted = true;
+    from_region.from_region = true;
+    from_region.missing = 0;
+    for (int v = box.y0; v <= box.y1; ++v)
+      for (int u = box.x0; u <= box.x1; ++u)
+        if (mask(u, v))
+          from_region.missing += lost(depth(u, v), plane_depth(from_region.plane, K, u, v, cos_max, params.max_depth), params);
+    if (float(from_region.missing) < params.min_missing * float(pixels)) continue;
+    MaskImage fresh(w, h, 0);
+    fill_mask_from_plane(depth, mask, box, dilate(mask, box, ring_width(box, params)), K, params, from_region, fresh);
+    if (from_region.filled == 0) continue;
+    for (size_t i = 0; i < fresh.size(); ++i)
+      if (fresh[i]) written[i] = result.filled[i] = 1;
+    from_region.skipped.clear();
+    rec = std::move(from_region);
+    result.pixels += rec.filled;
+    total += rec.filled;
+  }
+  return total;
 }
 
 void copy_filled_depth(const DepthImage& from, const MaskImage& filled, DepthImage& to) {

@@ -27,8 +27,9 @@ namespace rrg {
 
 struct ReflectiveFillParams {
   bool enabled = true;
-  // Frames that get no masks (the `remote` cue between identification frames) are filled from the
-  // surfaces the last fill with masks left (FillRegion below), at their tracked pose.
+  // The surfaces that fills with masks found (FillRegion below) fill, at the tracked pose, what is
+  // still lost in their footprints on every later frame: frames that get no masks (the `remote`
+  // cue between identification frames), and masks that fail their test or that the segmenter missed.
   bool carry = true;
   // A mask is filled when at least this share of its pixels has no depth or depth behind the ring's
   // plane: a mirror the sensor saw has next to none (edge dropouts), a lost one most of its area.
@@ -59,6 +60,10 @@ struct ReflectiveFillParams {
   // within the ring) are the glass beyond it, and are filled as well. Pixels without depth there are
   // left as they are (nothing is fused from them either way).
   bool grow_beyond_mask = true;
+  // A mask that fails the ring's test on a frame may take the plane of a carried region (carry) of
+  // its label when more than this share of its pixels meet that region's footprint: a surface found
+  // before, which the mask shows again (fill_failed_masks_from_regions).
+  float min_region_share = 0.5f;
   float max_ray_angle_deg = 80.0f;  // no fill where a ray meets the plane more obliquely
   int ransac_iterations = 128;      // deterministic (fixed seed)
   float max_depth = 10.0f;          // filled depths beyond this are left out, metres
@@ -82,6 +87,7 @@ struct ReflectiveFillMask {
   int sides = 0;              // sides of the mask's bounding box the inliers cover
   Plane plane;                // camera frame, facing the camera (d > 0), when fitted
   bool fitted = false;
+  bool from_region = false;   // the plane is a carried region's (fill_failed_masks_from_regions)
   std::string skipped;        // why nothing was written ("" when filled)
 };
 
@@ -101,18 +107,35 @@ ReflectiveFillResult fill_reflective_depth(DepthImage& depth, std::span<const Se
 // the masks the fill was given; throws std::invalid_argument when they are not.
 void add_glass_beyond(const ReflectiveFillResult& result, std::span<SemanticMask> masks);
 
-// What a fill leaves for the frames that get no masks (the `remote` cue's between identification
-// frames): each filled mask's surface in the world frame, its plane and the footprint (a grid of
-// `cell` metres on the plane, plane_footprint.h) of the mask's pixels on it.
+// What a fill leaves for later frames (ReflectiveFillParams::carry): each filled mask's surface in
+// the world frame, its plane and the footprint (a grid of `cell` metres on the plane,
+// plane_footprint.h) of the mask's pixels on it.
 struct FillRegion {
   std::string label;
   Plane plane;  // world frame
   Footprint footprint;
 };
 
-// The regions of the masks `result` filled, seen from T_wc (camera to world) with K.
+// The regions of the masks `result` filled from their rings, seen from T_wc (camera to world) with
+// K. A mask filled from a region (from_region) leaves none: that region stays as it was, with the
+// footprint a mask that passed the ring's test gave it.
 std::vector<FillRegion> fill_regions(const ReflectiveFillResult& result, std::span<const SemanticMask> masks,
                                      const Intrinsics& K, const Eigen::Isometry3f& T_wc, float cell = 0.05f);
+
+// The carried regions after a fill with masks: each fresh region replaces the carried ones of the
+// same surface, and the others stay, so that a mask failing its test on a later frame (a segmenter's
+// mask short of the glass or over its frame) still finds the surface an earlier mask found. Same
+// surface: the same label, normals within max_normal_angle_deg and each plane's footprint centre
+// within max_distance of the other plane (the global plane table's geometric filter), and more than
+// min_overlap of the carried footprint's cells on the fresh one (one-cell dilation).
+struct RegionMatch {
+  float max_normal_angle_deg = 10.0f;
+  float max_distance = 0.1f;
+  float min_overlap = 0.05f;
+};
+bool same_surface(const FillRegion& carried, const FillRegion& fresh, const RegionMatch& match = {});
+// Returns how many of the carried regions stayed: they come first, the fresh ones after them.
+size_t merge_fill_regions(std::vector<FillRegion>& carried, std::vector<FillRegion> fresh, const RegionMatch& match = {});
 
 // Fills `depth` from regions at pose T_wc: a pixel whose ray meets a region's plane from its front,
 // within its footprint dilated by one cell, and that has no depth or depth behind the plane takes
@@ -120,6 +143,18 @@ std::vector<FillRegion> fill_regions(const ReflectiveFillResult& result, std::sp
 // region in the result (pixels: those whose ray lands on the footprint).
 ReflectiveFillResult fill_from_regions(DepthImage& depth, std::span<const FillRegion> regions, const Intrinsics& K,
                                        const Eigen::Isometry3f& T_wc, const ReflectiveFillParams& params);
+
+// The masks `result` left unfilled (a ring that is not planar, seen on too few sides, ...) filled
+// from the carried regions at pose T_wc: a mask more than min_region_share of whose pixels meet the
+// footprint (dilated by one cell) of a region of its label takes that region's plane, and is filled
+// as fill_reflective_depth fills from a fitted plane (min_missing, the glass beyond it). Their
+// records in `result` are updated (plane, from_region, filled, beyond; skipped cleared), as are
+// result.filled and result.pixels; the pixels written are set in `written` too, and counted in the
+// return value. Throws std::invalid_argument when the sizes differ or the masks are not the fill's.
+int64_t fill_failed_masks_from_regions(DepthImage& depth, ReflectiveFillResult& result,
+                                       std::span<const SemanticMask> masks, std::span<const FillRegion> regions,
+                                       const Intrinsics& K, const Eigen::Isometry3f& T_wc,
+                                       const ReflectiveFillParams& params, MaskImage& written);
 
 // Writes the filled pixels of `from` into `to` (the same fill applied to another copy of the
 // frame's depth, e.g. the tracker's filtered one). Throws std::invalid_argument on size mismatch.

@@ -267,13 +267,13 @@ FrameReport Session::process(const SessionFrame& frame) {
   report.index = frame.index;
   report.timestamp = frame.timestamp;
 
-  // 0. depth the sensor lost on reflective masks, filled from the plane around them before
-  // tracking, identification and fusion (planes.fill, core/planes/reflective_fill.h): on the
+  // 0. depth the sensor lost on reflective masks, filled from the plane around them for
+  // identification, fusion and the mapper (planes.fill, core/planes/reflective_fill.h): on the
   // frames whose masks the cue gives anyway (identification frames) or at no cost (labels).
   const bool identify_due = s.fused % s.config.plane_period == 0;
   std::optional<std::vector<SemanticMask>> masks;
   std::optional<ReflectiveFillResult> mask_fill;  // kept for its regions once the pose is known
-  DepthImage filled;
+  DepthImage filled, tracked;  // D_k filled for the map; D_k for tracking
   const DepthImage* D_k = &frame.depth;
   const SemanticCue& cue = s.identifier.cue();
   if (s.config.planes.fill.enabled && !cue.every_plane_is_candidate() &&
@@ -284,7 +284,15 @@ FrameReport Session::process(const SessionFrame& frame) {
     filled = frame.depth;
     mask_fill = fill_reflective_depth(filled, *masks, s.K, s.config.planes.fill_params());
     report.filled_pixels = mask_fill->pixels;
-    if (mask_fill->pixels > 0) D_k = &filled;
+    // Tracking leaves out the pixels the fill wrote (lost, or seen through the glass), so that a
+    // plane fitted a little off from frame to frame (a mask short of the glass takes in its frame)
+    // does not move the pose, and the depth seen through the glass is no outlier of ICP's.
+    if (mask_fill->pixels > 0) {
+      tracked = frame.depth;
+      for (size_t i = 0; i < tracked.size(); ++i)
+        if (mask_fill->filled[i]) tracked[i] = 0.0f;
+      D_k = &tracked;
+    }
     for (const ReflectiveFillMask& m : mask_fill->masks)
       spdlog::debug("frame {}: {} mask, {} px, {} missing: {}", frame.index, m.label, m.pixels, m.missing,
                     m.skipped.empty() ? fmt::format("{} px filled", m.filled) : m.skipped);
@@ -318,31 +326,45 @@ FrameReport Session::process(const SessionFrame& frame) {
     keyframe = r.keyframe || r.first;
   }
 
-  // The fill, between frames with masks: the last fill's surfaces (world regions) at the tracked
-  // pose, for fusion and the mapper (tracking saw this frame as it came; ICP's association drops
-  // points behind the model's surface). A fill with masks leaves its regions for the next frames.
+  // The fill, between frames with masks: the surfaces earlier fills found (world regions) at the
+  // tracked pose, for fusion and the mapper (tracking saw this frame as it came, less the pixels its
+  // masks filled; ICP's association drops points behind the model's surface). On a frame with masks, a
+  // mask that failed the ring's test (a segmenter's mask short of the glass or over its frame) takes
+  // the plane of the region it lies on, and the masks filled update the regions; the regions no mask
+  // showed again then fill what is still lost in their footprints (glass the segmenter missed), as
+  // on frames without masks. (A region a mask filled is not applied over it: its footprint, dilated
+  // by a cell, would press the wall around the glass onto a plane fitted a little in front of it.)
   std::optional<DeviceImage<float>> fuse_override;  // the filtered depth, filled
-  if (report.state != TrackingState::Lost && s.config.planes.fill.enabled) {
+  if (report.state != TrackingState::Lost && s.config.planes.fill.enabled && (mask_fill || s.config.planes.fill.carry)) {
     const auto tf = Clock::now();
-    if (mask_fill) {
-      // (with masks on every frame, as with labels, there is nothing to carry)
-      if (mask_fill->pixels > 0 && s.config.planes.fill.carry && !cue.masks_with_every_frame()) {
-        std::vector<FillRegion> regions = fill_regions(*mask_fill, *masks, s.K, report.T_wc);
-        if (!regions.empty()) s.fill_regions = std::move(regions);
+    const ReflectiveFillParams params = s.config.planes.fill_params();
+    DepthImage carried = mask_fill ? std::move(filled) : frame.depth;  // the masks' fill, if any
+    MaskImage written = mask_fill ? mask_fill->filled : MaskImage(s.K.width, s.K.height, 0);
+    int64_t pixels = 0;  // beyond the masks' own fill
+    size_t unseen = s.fill_regions.size();  // the regions no mask of this frame showed again come first
+    if (s.config.planes.fill.carry) {
+      if (mask_fill) {
+        pixels += fill_failed_masks_from_regions(carried, *mask_fill, *masks, s.fill_regions, s.K, report.T_wc, params, written);
+        if (mask_fill->pixels > 0)
+          unseen = merge_fill_regions(s.fill_regions, fill_regions(*mask_fill, *masks, s.K, report.T_wc));
       }
-    } else if (s.config.planes.fill.carry && !s.fill_regions.empty()) {
-      filled = frame.depth;
-      const ReflectiveFillResult fr = fill_from_regions(filled, s.fill_regions, s.K, report.T_wc, s.config.planes.fill_params());
-      report.filled_pixels = fr.pixels;
-      if (fr.pixels > 0) {
-        D_k = &filled;
-        if (const DeviceImage<float>* f = s.config.gt_poses ? nullptr : s.tracker.preprocessed_depth()) {
-          DepthImage host = f->to_host();
-          copy_filled_depth(filled, fr.filled, host);
-          fuse_override = DeviceImage<float>::from_host(host, s.config.device);
-        } else {
-          fuse_override = DeviceImage<float>::from_host(filled, s.config.device);
-        }
+      if (unseen > 0) {
+        const ReflectiveFillResult fr =
+            fill_from_regions(carried, std::span(s.fill_regions).first(unseen), s.K, report.T_wc, params);
+        pixels += fr.pixels;
+        for (size_t i = 0; i < written.size(); ++i) written[i] |= fr.filled[i];
+      }
+    }
+    report.filled_pixels += pixels;
+    if (report.filled_pixels > 0) {
+      filled = std::move(carried);
+      D_k = &filled;
+      if (const DeviceImage<float>* f = s.config.gt_poses ? nullptr : s.tracker.preprocessed_depth()) {
+        DepthImage host = f->to_host();
+        copy_filled_depth(filled, written, host);
+        fuse_override = DeviceImage<float>::from_host(host, s.config.device);
+      } else {
+        fuse_override = DeviceImage<float>::from_host(filled, s.config.device);
       }
     }
     report.times.identify += ms_since(tf);

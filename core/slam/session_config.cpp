@@ -212,10 +212,12 @@ std::vector<ConfigField> config_fields(SessionConfig& c) {
   t.b("planes.fill.enabled", c.planes.fill.enabled,
       "fill the depth the sensor lost on reflective masks from the plane around them (labels / remote cues)");
   t.b("planes.fill.carry", c.planes.fill.carry,
-      "frames without masks (remote cue between identification frames) fill from the last fill's surfaces");
+      "later frames fill what is still lost on the surfaces earlier fills found (frames without masks, masks that fail)");
   t.f("planes.fill.min_missing", c.planes.fill.min_missing,
       "fill a mask when this share of its pixels has no depth or depth behind that plane");
   t.f("planes.fill.min_inlier_ratio", c.planes.fill.min_inlier_ratio, "share of the ring around the mask on one plane");
+  t.f("planes.fill.min_region_share", c.planes.fill.min_region_share,
+      "a mask failing the ring's test takes a carried surface's plane when this share of it lies on that surface");
   t.b("planes.fill.grow_beyond_mask", c.planes.fill.grow_beyond_mask,
       "fill the glass a mask stops short of: ring pixels behind the plane that connect to the mask");
   t.i("planes.fill.min_sides", c.planes.fill.min_sides, "sides of the mask's bounding box that plane must be seen on");

@@ -320,5 +320,133 @@ TEST(ReflectiveFill, ARegionCarriesTheFillToAViewWithoutMasks) {
   EXPECT_EQ(b.masks[0].skipped, "seen from behind");
 }
 
+// A mask that fails the ring's test takes a carried region's plane: view 1 fills the mirror and
+// leaves its region; view 2 (moved 12 cm, turned 4°) sees through the glass, and its mask stops 8 px
+// short of the glass all round, so its ring is glass seen through and the fill from the ring fails.
+// The region's plane then fills the mask and the glass beyond it, every glass pixel and nothing
+// else. The same mask under another label, or a mask elsewhere on the wall, is not filled.
+TEST(ReflectiveFill, AMaskThatFailsTakesTheCarriedRegionsPlane) {
+  DepthImage depth = wall_with_hole(50, 30, 110, 90);
+  const SemanticMask mirror = rect_mask(50, 30, 110, 90);
+  const ReflectiveFillResult r = fill_reflective_depth(depth, std::span(&mirror, 1), kK, ReflectiveFillParams{});
+  const std::vector<FillRegion> regions = fill_regions(r, std::span(&mirror, 1), kK, Eigen::Isometry3f::Identity());
+  ASSERT_EQ(regions.size(), 1u);
+
+  Eigen::Isometry3f T2 = Eigen::Isometry3f::Identity();
+  T2.linear() = Eigen::AngleAxisf(4.0f * float(M_PI) / 180.0f, Eigen::Vector3f::UnitY()).toRotationMatrix();
+  T2.translation() = Eigen::Vector3f(0.12f, 0.04f, 0.0f);
+  const Plane wall_c2 = wall().transformed(T2.inverse());
+  const auto wall_z = [&](int u, int v) {
+    return -wall_c2.d / wall_c2.n.dot(Eigen::Vector3f((float(u) - kK.cx) / kK.fx, (float(v) - kK.cy) / kK.fy, 1.0f));
+  };
+  DepthImage d2(kK.width, kK.height);
+  MaskImage glass(kK.width, kK.height, 0);
+  int64_t glass_px = 0;
+  for (int v = 0; v < kK.height; ++v)
+    for (int u = 0; u < kK.width; ++u) {
+      const float z = wall_z(u, v);
+      const Eigen::Vector2f px = kK.project(T2 * (z * Eigen::Vector3f((float(u) - kK.cx) / kK.fx, (float(v) - kK.cy) / kK.fy, 1.0f)));
+      glass(u, v) = px.x() >= 49.5f && px.x() <= 110.5f && px.y() >= 29.5f && px.y() <= 90.5f;
+      glass_px += glass(u, v);
+      d2(u, v) = glass(u, v) ? z + 1.5f : z;
+    }
+  ASSERT_GT(glass_px, 2000);
+  SemanticMask short_mask;
+  short_mask.mask = MaskImage(kK.width, kK.height, 0);
+  short_mask.label = "mirror";
+  short_mask.reflective = true;
+  for (int v = 8; v < kK.height - 8; ++v)
+    for (int u = 8; u < kK.width - 8; ++u) {
+      bool inner = true;
+      for (int dv = -8; dv <= 8 && inner; dv += 8)
+        for (int du = -8; du <= 8 && inner; du += 8) inner = glass(u + du, v + dv);
+      short_mask.mask(u, v) = inner;
+    }
+  // Another glass on the wall, off the region, seen through, and its mask as short of it.
+  SemanticMask elsewhere = rect_mask(10, 102, 40, 112);
+  for (int v = 94; v <= 119; ++v)
+    for (int u = 2; u <= 48; ++u) {
+      ASSERT_FALSE(glass(u, v));
+      d2(u, v) += 1.5f;
+    }
+  SemanticMask other_label = short_mask;
+  other_label.label = "window";
+  const std::vector<SemanticMask> masks{short_mask, elsewhere, other_label};
+
+  DepthImage filled = d2;
+  ReflectiveFillResult fr = fill_reflective_depth(filled, masks, kK, ReflectiveFillParams{});
+  ASSERT_EQ(fr.masks.size(), 3u);
+  for (const ReflectiveFillMask& m : fr.masks) ASSERT_EQ(m.filled, 0) << m.label << ": " << m.skipped;
+  MaskImage written(kK.width, kK.height, 0);
+  const int64_t n = fill_failed_masks_from_regions(filled, fr, masks, regions, kK, T2, ReflectiveFillParams{}, written);
+  int64_t mask_px = 0;
+  for (const uint8_t m : short_mask.mask.pixels()) mask_px += m;
+  EXPECT_GT(n, mask_px + 300) << "the mask's pixels and the glass beyond it (within its ring)";
+  EXPECT_EQ(fr.pixels, n);
+  EXPECT_TRUE(fr.masks[0].from_region);
+  EXPECT_EQ(fr.masks[0].skipped, "");
+  EXPECT_EQ(int64_t(fr.masks[0].beyond.size()), n - mask_px);
+  EXPECT_EQ(fr.masks[1].filled, 0) << "a mask off the region";
+  EXPECT_EQ(fr.masks[2].filled, 0) << "another label";
+  // The region's footprint takes the rest of the glass (the session runs fill_from_regions next).
+  const ReflectiveFillResult rest = fill_from_regions(filled, regions, kK, T2, ReflectiveFillParams{});
+  EXPECT_EQ(n + rest.pixels, glass_px);
+  for (int v = 0; v < kK.height; ++v)
+    for (int u = 0; u < kK.width; ++u) {
+      EXPECT_EQ(written(u, v) || rest.filled(u, v), glass(u, v)) << u << "," << v;
+      EXPECT_EQ(written(u, v), fr.filled(u, v)) << u << "," << v;
+      if (glass(u, v)) EXPECT_NEAR(filled(u, v), wall_z(u, v), 1e-3f) << u << "," << v;
+      else EXPECT_EQ(filled(u, v), d2(u, v)) << u << "," << v;
+    }
+  // Without a region nothing is written.
+  DepthImage again = d2;
+  ReflectiveFillResult none = fill_reflective_depth(again, masks, kK, ReflectiveFillParams{});
+  MaskImage w2(kK.width, kK.height, 0);
+  EXPECT_EQ(fill_failed_masks_from_regions(again, none, masks, {}, kK, T2, ReflectiveFillParams{}, w2), 0);
+}
+
+// A square region of side 2·half on `plane` around the point of it nearest `near` (world frame).
+FillRegion square_region(const Plane& plane, const Eigen::Vector3f& near, float half, const char* label = "mirror") {
+  const Eigen::Vector3f centre = near - plane.signed_distance(near) * plane.n;
+  FillRegion r;
+  r.label = label;
+  r.plane = plane;
+  r.footprint = Footprint(PlaneBasis::from_plane(plane, centre), 0.05f);
+  std::vector<Eigen::Vector3f> points;
+  for (float x = -half; x <= half; x += 0.02f)
+    for (float y = -half; y <= half; y += 0.02f)
+      points.push_back(centre + x * r.footprint.basis().u + y * r.footprint.basis().v);
+  r.footprint.add_points(points);
+  return r;
+}
+
+Plane offset(const Plane& p, float by) { return {p.n, p.d - by}; }  // moved by `by` along n
+Plane tilted(const Plane& p, float deg, const Eigen::Vector3f& through) {
+  const Eigen::Vector3f n = Eigen::AngleAxisf(deg * float(M_PI) / 180.0f, Eigen::Vector3f::UnitX()) * p.n;
+  return {n, -n.dot(through)};
+}
+
+// The same mirror found again (a view later, its plane 3 cm off and 4° turned, a mask a little
+// smaller) replaces the carried region; another mirror on the same wall, or the same place under
+// another label, or a plane 15° or 15 cm away, is another surface and stays.
+TEST(ReflectiveFill, RegionsOfTheSameSurfaceReplaceEachOther) {
+  const Plane p = wall();
+  const Eigen::Vector3f at(0.0f, 0.0f, 2.5f), beside(1.2f, 0.0f, 2.5f - 1.2f * 0.2f);
+  const FillRegion mirror = square_region(p, at, 0.4f);
+  const FillRegion again = square_region(tilted(offset(p, 0.03f), 4.0f, at), at + Eigen::Vector3f(0.05f, 0.0f, 0.0f), 0.3f);
+  EXPECT_TRUE(same_surface(mirror, again));
+  EXPECT_TRUE(same_surface(again, mirror));
+  EXPECT_FALSE(same_surface(mirror, square_region(p, beside, 0.4f))) << "another mirror on the wall";
+  EXPECT_FALSE(same_surface(mirror, square_region(p, at, 0.4f, "window"))) << "another label";
+  EXPECT_FALSE(same_surface(mirror, square_region(tilted(p, 15.0f, at), at, 0.4f))) << "15 degrees";
+  EXPECT_FALSE(same_surface(mirror, square_region(offset(p, 0.15f), at, 0.4f))) << "15 cm";
+
+  std::vector<FillRegion> carried{mirror, square_region(p, beside, 0.4f)};
+  merge_fill_regions(carried, {again});
+  ASSERT_EQ(carried.size(), 2u);
+  EXPECT_GT(carried[0].footprint.basis().origin.x(), 0.6f * beside.x()) << "the other mirror stays";
+  EXPECT_EQ(carried[1].footprint.cells(), again.footprint.cells()) << "the fresh region replaced the old one";
+}
+
 }  // namespace
 }  // namespace rrg

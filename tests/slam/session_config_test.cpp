@@ -80,6 +80,17 @@ TEST(SessionConfig, OverridesSetFieldsAndRejectNonsense) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("planes.fill.min_sides"), std::string::npos) << e.what();
   }
+  apply_override(c, "planes.fill.min_sides=2");
+  apply_override(c, "planes.fill.min_region_share=0.7");
+  EXPECT_FLOAT_EQ(c.planes.fill.min_region_share, 0.7f);
+  c.validate();
+  apply_override(c, "planes.fill.min_region_share=1.5");
+  try {
+    c.validate();
+    FAIL() << "min_region_share 1.5 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("planes.fill.min_region_share"), std::string::npos) << e.what();
+  }
 }
 
 TEST(SessionConfig, YamlFilesAreNestedAndRoundTrip) {

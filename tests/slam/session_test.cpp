@@ -170,6 +170,98 @@ TEST_F(SessionTest, FramesWithoutMasksFillFromTheLastFill) {
   }
 }
 
+// Masks on every frame (labels), a sensor that sees through the mirror, and a segmenter that fails
+// on frames 5-9: it misses the mirror on 5-7 (labelled wall) and gives only its middle on 8-9 (the
+// mask eroded by 6 px: its ring is glass seen through, no plane to fill from). The surfaces earlier
+// fills found (FillRegion) fill those frames as they fill frames without masks, so no frame fuses
+// the mirrored room; without the carry those five frames put it in the map behind the glass.
+TEST_F(SessionTest, MasksThatFailOrAreMissedFillFromEarlierFills) {
+  const auto d = io::open_dataset(root());
+  const uint16_t mirror_id = category_id("mirror"), wall_id = category_id("wall");
+  ASSERT_NE(mirror_id, 0);
+  ASSERT_NE(wall_id, 0);
+  const auto corrupt = [&](LabelImage& labels, size_t i) {
+    if (i < 5 || i > 9) return;
+    const LabelImage in = labels;
+    const int w = in.width(), h = in.height(), k = 6;
+    for (int v = 0; v < h; ++v)
+      for (int u = 0; u < w; ++u) {
+        if (in(u, v) != mirror_id) continue;
+        bool inner = i >= 8;
+        for (int dv = -k; dv <= k && inner; ++dv)
+          for (int du = -k; du <= k && inner; ++du) {
+            const int x = u + du, y = v + dv;
+            inner = x >= 0 && y >= 0 && x < w && y < h && in(x, y) == mirror_id;
+          }
+        if (!inner) labels(u, v) = wall_id;
+      }
+  };
+  for (const bool carry : {true, false}) {
+    SCOPED_TRACE(carry ? "carry" : "no carry");
+    SessionConfig c = config(*d);
+    c.gt_poses = true;
+    c.planes.fill.carry = carry;
+    Session s(c);
+    std::vector<int64_t> filled(20, 0);
+    for (size_t i = 0; i < 20; ++i) {
+      SessionFrame f = frame(*d, i, true);
+      for (size_t k = 0; k < f.depth.size(); ++k)
+        if ((*f.labels)[k] == mirror_id && f.depth[k] > 0.0f) f.depth[k] += 1.5f;
+      corrupt(*f.labels, i);
+      filled[i] = s.process(f).filled_pixels;
+    }
+    s.finish();
+    for (size_t i = 0; i < 20; ++i) EXPECT_EQ(filled[i] > 0, carry || i < 5 || i > 9) << "frame " << i;
+    // Map vertices seen through the probe view's mirror pixels, more than 0.5 m behind the glass.
+    const SessionFrame probe = frame(*d, 15, true);
+    const Eigen::Isometry3f T_cw = probe.pose->inverse();
+    int64_t behind = 0;
+    for (const Eigen::Vector3f& p_w : s.mesh().vertices) {
+      const Eigen::Vector3f p = T_cw * p_w;
+      if (!(p.z() > 0.1f)) continue;
+      const Eigen::Vector2f uv = c.K.project(p);
+      const int u = int(std::lround(uv.x())), v = int(std::lround(uv.y()));
+      if (u < 0 || v < 0 || u >= c.K.width || v >= c.K.height || (*probe.labels)(u, v) != mirror_id) continue;
+      behind += probe.depth(u, v) > 0.0f && p.z() > probe.depth(u, v) + 0.5f;
+    }
+    if (carry) EXPECT_EQ(behind, 0) << "the mirrored room is in the map";
+    else EXPECT_GT(behind, 100) << "the five frames did not fuse the room behind the glass";
+  }
+}
+
+// Tracking with a sensor that sees through the mirror, which here fills about two thirds of every
+// frame. The fill writes the wall's plane over the glass for the map, but tracking leaves out the
+// pixels it wrote: a plane fitted a little off from frame to frame (a mask short of the glass takes
+// in its frame, docs/planes.md) would move the pose, and the room seen through the glass is no
+// surface of the map. Every frame tracks Ok (with the see-through depth in ICP most of each frame is
+// outliers), and the trajectory stays within 3 cm (tracking on the filled depth drifted to an ATE of
+// 8.9 cm on these frames; leaving the glass out, 1.5 cm: what is left of the frame is mostly the
+// wall, which leaves the pose free along it).
+TEST_F(SessionTest, TrackingLeavesOutTheFilledGlass) {
+  const auto d = io::open_dataset(root());
+  const uint16_t mirror_id = category_id("mirror");
+  io::Trajectory gt = d->ground_truth();
+  gt.resize(24);
+  for (const bool through : {false, true}) {
+    SCOPED_TRACE(through ? "seen through" : "the glass with its depth");
+    Session s(config(*d));
+    int64_t filled = 0;
+    for (size_t i = 0; i < 24; ++i) {
+      SessionFrame f = frame(*d, i, i == 0);
+      if (through)
+        for (size_t k = 0; k < f.depth.size(); ++k)
+          if ((*f.labels)[k] == mirror_id && f.depth[k] > 0.0f) f.depth[k] += 1.5f;
+      const FrameReport r = s.process(f);
+      filled += r.filled_pixels;
+      EXPECT_EQ(r.state, TrackingState::Ok) << "frame " << i << ": " << r.note;
+    }
+    s.finish();
+    const auto m = eval::evaluate_trajectory(s.trajectory(), gt);
+    EXPECT_EQ(filled > 24 * 5000, through) << filled << " pixels filled";
+    EXPECT_LT(m.ate.rmse_cm, through ? 3.0 : 0.5) << "ATE " << m.ate.rmse_cm << " cm";
+  }
+}
+
 TEST_F(SessionTest, TracksTheSequence) {
   const auto d = io::open_dataset(root());
   Session s(config(*d));
