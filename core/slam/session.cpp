@@ -9,6 +9,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <optional>
 #include <stdexcept>
@@ -284,19 +285,37 @@ FrameReport Session::process(const SessionFrame& frame) {
     filled = frame.depth;
     mask_fill = fill_reflective_depth(filled, *masks, s.K, s.config.planes.fill_params());
     report.filled_pixels = mask_fill->pixels;
-    // Tracking leaves out the pixels the fill wrote (lost, or seen through the glass), so that a
-    // plane fitted a little off from frame to frame (a mask short of the glass takes in its frame)
-    // does not move the pose, and the depth seen through the glass is no outlier of ICP's.
-    if (mask_fill->pixels > 0) {
-      tracked = frame.depth;
-      for (size_t i = 0; i < tracked.size(); ++i)
-        if (mask_fill->filled[i]) tracked[i] = 0.0f;
-      D_k = &tracked;
-    }
     for (const ReflectiveFillMask& m : mask_fill->masks)
       spdlog::debug("frame {}: {} mask, {} px, {} missing: {}", frame.index, m.label, m.pixels, m.missing,
                     m.skipped.empty() ? fmt::format("{} px filled", m.filled) : m.skipped);
     report.times.identify = ms_since(tf);
+  }
+  // Tracking leaves out the pixels the fill writes (lost, or seen through the glass), so that a
+  // plane fitted a little off from frame to frame (a mask short of the glass takes in its frame)
+  // does not move the pose, and the depth seen through the glass is no outlier of ICP's: those of
+  // the masks' own fill, and those the carried regions will fill after tracking, found here at the
+  // predicted pose (the fill itself waits for the tracked one).
+  if (s.config.planes.fill.enabled && !s.config.gt_poses) {
+    const auto tf = Clock::now();
+    MaskImage blank = mask_fill ? mask_fill->filled : MaskImage(s.K.width, s.K.height, 0);
+    if (s.config.planes.fill.carry && !s.fill_regions.empty() && s.frames > 0) {
+      const Eigen::Isometry3f T_pred = frame.pose ? *frame.pose : s.tracker.predicted_pose();
+      const ReflectiveFillParams params = s.config.planes.fill_params();
+      DepthImage probe = mask_fill ? filled : frame.depth;
+      if (mask_fill) {
+        ReflectiveFillResult failed = *mask_fill;
+        fill_failed_masks_from_regions(probe, failed, *masks, s.fill_regions, s.K, T_pred, params, blank);
+      }
+      const ReflectiveFillResult fr = fill_from_regions(probe, s.fill_regions, s.K, T_pred, params);
+      for (size_t i = 0; i < blank.size(); ++i) blank[i] |= fr.filled[i];
+    }
+    if (std::any_of(blank.pixels().begin(), blank.pixels().end(), [](uint8_t b) { return b != 0; })) {
+      tracked = frame.depth;
+      for (size_t i = 0; i < tracked.size(); ++i)
+        if (blank[i]) tracked[i] = 0.0f;
+      D_k = &tracked;
+    }
+    report.times.identify += ms_since(tf);
   }
   const auto depth = DeviceImage<float>::from_host(*D_k, s.config.device);
   const auto color = DeviceImage<Color>::from_host(frame.color, s.config.device);
