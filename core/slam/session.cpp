@@ -344,6 +344,7 @@ FrameReport Session::process(const SessionFrame& frame) {
     report.times.orb = r.ms_orb;
     keyframe = r.keyframe || r.first;
   }
+  if (D_k == &tracked) D_k = &frame.depth;  // the map takes the frame, filled below, not what tracking saw
 
   // The fill, between frames with masks: the surfaces earlier fills found (world regions) at the
   // tracked pose, for fusion and the mapper (tracking saw this frame as it came, less the pixels its
