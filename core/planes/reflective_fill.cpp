@@ -395,16 +395,15 @@ ReflectiveFillResult fill_from_regions(DepthImage& depth, std::span<const FillRe
     const auto on_footprint = [&](const Eigen::Vector3f& p_w) { return on_dilated_footprint(region.footprint, p_w); };
     for (int v = 0; v < h; ++v)
       for (int u = 0; u < w; ++u) {
+        // The depth test first: most pixels keep theirs, and then need no footprint lookups.
         const float z = plane_depth(rec.plane, K, u, v, cos_max, params.max_depth);
-        if (!(z > 0.0f) || !on_footprint(T_wc * (z * K.unproject(float(u), float(v), 1.0f)))) continue;
-        ++rec.pixels;
-        if (lost(depth(u, v), z, params)) {
-          ++rec.missing;
-          depth(u, v) = z;
-          out.filled(u, v) = 1;
-          ++rec.filled;
-        }
+        if (!(z > 0.0f) || !lost(depth(u, v), z, params)) continue;
+        if (!on_footprint(T_wc * (z * K.unproject(float(u), float(v), 1.0f)))) continue;
+        depth(u, v) = z;
+        out.filled(u, v) = 1;
+        ++rec.filled;
       }
+    rec.pixels = rec.missing = rec.filled;
     out.pixels += rec.filled;
     out.masks.push_back(std::move(rec));
   }

@@ -140,7 +140,7 @@ size_t merge_fill_regions(std::vector<FillRegion>& carried, std::vector<FillRegi
 // Fills `depth` from regions at pose T_wc: a pixel whose ray meets a region's plane from its front,
 // within its footprint dilated by one cell, and that has no depth or depth behind the plane takes
 // the plane's depth (the same tolerance and angle limit as fill_reflective_depth). One record per
-// region in the result (pixels: those whose ray lands on the footprint).
+// region in the result (pixels, missing and filled: the pixels it wrote).
 ReflectiveFillResult fill_from_regions(DepthImage& depth, std::span<const FillRegion> regions, const Intrinsics& K,
                                        const Eigen::Isometry3f& T_wc, const ReflectiveFillParams& params);
 
