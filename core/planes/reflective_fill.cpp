@@ -343,6 +343,28 @@ bool on_dilated_footprint(const Footprint& fp, const Eigen::Vector3f& p_w) {
   return false;
 }
 
+// The pixels [x0, x1] x [y0, y1] that a footprint dilated by one cell can cover from a camera
+// (T_cw, K): the image of its bounding box grown by two cells (a cell reaches one past the points
+// that made it, the dilation one more), a convex quad whose corners bound it when all are in front
+// of the camera; the whole image otherwise. x1 < x0 when it is out of view.
+Box footprint_window(const Footprint& fp, const Eigen::Isometry3f& T_cw, const Intrinsics& K) {
+  const Box whole{0, 0, K.width - 1, K.height - 1};
+  if (fp.box().empty) return whole;
+  const float m = 2.0f * fp.cell_size();
+  float u0 = std::numeric_limits<float>::max(), v0 = u0, u1 = -u0, v1 = -u0;
+  for (int c = 0; c < 4; ++c) {
+    const float x = (c & 1) ? fp.box().max.x() + m : fp.box().min.x() - m;
+    const float y = (c & 2) ? fp.box().max.y() + m : fp.box().min.y() - m;
+    const Eigen::Vector3f p = T_cw * (fp.basis().origin + x * fp.basis().u + y * fp.basis().v);
+    if (!(p.z() > 1e-3f)) return whole;
+    const Eigen::Vector2f uv = K.project(p);
+    u0 = std::min(u0, uv.x()), u1 = std::max(u1, uv.x()), v0 = std::min(v0, uv.y()), v1 = std::max(v1, uv.y());
+  }
+  if (u1 < 0.0f || v1 < 0.0f || u0 > float(K.width - 1) || v0 > float(K.height - 1)) return {0, 0, -1, -1};
+  return {std::max(0, int(std::floor(u0))), std::max(0, int(std::floor(v0))),
+          std::min(K.width - 1, int(std::ceil(u1))), std::min(K.height - 1, int(std::ceil(v1)))};
+}
+
 // The centre of a footprint's bounding box, in the world frame (on its plane).
 Eigen::Vector3f footprint_centre(const Footprint& fp) {
   const Eigen::Vector2f c = 0.5f * (fp.box().min + fp.box().max);
@@ -392,9 +414,15 @@ ReflectiveFillResult fill_from_regions(DepthImage& depth, std::span<const FillRe
       out.masks.push_back(std::move(rec));
       continue;
     }
+    const Box window = footprint_window(region.footprint, T_cw, K);
+    if (window.x1 < window.x0) {
+      rec.skipped = "out of view";
+      out.masks.push_back(std::move(rec));
+      continue;
+    }
     const auto on_footprint = [&](const Eigen::Vector3f& p_w) { return on_dilated_footprint(region.footprint, p_w); };
-    for (int v = 0; v < h; ++v)
-      for (int u = 0; u < w; ++u) {
+    for (int v = window.y0; v <= window.y1; ++v)
+      for (int u = window.x0; u <= window.x1; ++u) {
         // The depth test first: most pixels keep theirs, and then need no footprint lookups.
         const float z = plane_depth(rec.plane, K, u, v, cos_max, params.max_depth);
         if (!(z > 0.0f) || !lost(depth(u, v), z, params)) continue;

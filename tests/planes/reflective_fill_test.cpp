@@ -318,6 +318,13 @@ TEST(ReflectiveFill, ARegionCarriesTheFillToAViewWithoutMasks) {
   const ReflectiveFillResult b = fill_from_regions(empty, regions, kK, behind, ReflectiveFillParams{});
   EXPECT_EQ(b.pixels, 0);
   EXPECT_EQ(b.masks[0].skipped, "seen from behind");
+  // Turned 60° away, the region is in front of the camera but out of view: not even looked at.
+  Eigen::Isometry3f away = Eigen::Isometry3f::Identity();
+  away.linear() = Eigen::AngleAxisf(60.0f * float(M_PI) / 180.0f, Eigen::Vector3f::UnitY()).toRotationMatrix();
+  DepthImage none(kK.width, kK.height, 0.0f);
+  const ReflectiveFillResult a = fill_from_regions(none, regions, kK, away, ReflectiveFillParams{});
+  EXPECT_EQ(a.pixels, 0);
+  EXPECT_EQ(a.masks[0].skipped, "out of view");
 }
 
 // A mask that fails the ring's test takes a carried region's plane: view 1 fills the mirror and
