@@ -84,6 +84,15 @@ void Footprint::merge(const Footprint& other) {
   }
 }
 
+bool Footprint::covers(const Eigen::Vector3f& p) const {
+  const Eigen::Vector2f q = basis_.project(p) / cell_;
+  const int i = int(std::floor(q.x())), j = int(std::floor(q.y()));
+  for (int di = -1; di <= 1; ++di)
+    for (int dj = -1; dj <= 1; ++dj)
+      if (contains_cell(i + di, j + dj)) return true;
+  return false;
+}
+
 float Footprint::overlap_ratio(const Footprint& other) const {
   if (other.cells_.empty()) return 0.0f;
   size_t hit = 0;

@@ -42,6 +42,8 @@ class Footprint {
   size_t cells() const { return cells_.size(); }
   const Box2& box() const { return box_; }
   bool contains_cell(int i, int j) const { return cells_.count(key(i, j)) > 0; }
+  // Whether p (world frame, on or near the plane) falls in this footprint dilated by one cell.
+  bool covers(const Eigen::Vector3f& p) const;
 
   // Projects points (world frame, on or near the plane) into the grid.
   void add_points(std::span<const Eigen::Vector3f> points);

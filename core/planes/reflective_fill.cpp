@@ -333,16 +333,6 @@ std::vector<FillRegion> fill_regions(const ReflectiveFillResult& result, std::sp
 
 namespace {
 
-// Whether p_w (on the footprint's plane) falls in the footprint dilated by one cell.
-bool on_dilated_footprint(const Footprint& fp, const Eigen::Vector3f& p_w) {
-  const Eigen::Vector2f q = fp.basis().project(p_w) / fp.cell_size();
-  const int i = int(std::floor(q.x())), j = int(std::floor(q.y()));
-  for (int di = -1; di <= 1; ++di)
-    for (int dj = -1; dj <= 1; ++dj)
-      if (fp.contains_cell(i + di, j + dj)) return true;
-  return false;
-}
-
 // The pixels [x0, x1] x [y0, y1] that a footprint dilated by one cell can cover from a camera
 // (T_cw, K): the image of its bounding box grown by two cells (a cell reaches one past the points
 // that made it, the dilation one more), a convex quad whose corners bound it when all are in front
@@ -420,13 +410,12 @@ ReflectiveFillResult fill_from_regions(DepthImage& depth, std::span<const FillRe
       out.masks.push_back(std::move(rec));
       continue;
     }
-    const auto on_footprint = [&](const Eigen::Vector3f& p_w) { return on_dilated_footprint(region.footprint, p_w); };
     for (int v = window.y0; v <= window.y1; ++v)
       for (int u = window.x0; u <= window.x1; ++u) {
         // The depth test first: most pixels keep theirs, and then need no footprint lookups.
         const float z = plane_depth(rec.plane, K, u, v, cos_max, params.max_depth);
         if (!(z > 0.0f) || !lost(depth(u, v), z, params)) continue;
-        if (!on_footprint(T_wc * (z * K.unproject(float(u), float(v), 1.0f)))) continue;
+        if (!region.footprint.covers(T_wc * (z * K.unproject(float(u), float(v), 1.0f)))) continue;
         depth(u, v) = z;
         out.filled(u, v) = 1;
         ++rec.filled;
@@ -460,20 +449,21 @@ int64_t fill_failed_masks_from_regions(DepthImage& depth, ReflectiveFillResult& 
     const Box box = mask_box(mask, pixels);
     if (pixels < params.min_mask_pixels) continue;
     // The region of the mask's label that the most of its pixels (every second one per axis) meet.
+    int64_t sampled = 0;
+    for (int v = box.y0; v <= box.y1; v += 2)
+      for (int u = box.x0; u <= box.x1; u += 2) sampled += mask(u, v) != 0;
     const FillRegion* best = nullptr;
-    int64_t best_on = 0, sampled = 0;
+    int64_t best_on = 0;
     for (const FillRegion& region : regions) {
       if (region.label != rec.label) continue;
       const Plane pc = region.plane.transformed(T_cw);
       if (!(pc.d > 0.0f)) continue;  // seen from behind
       int64_t on = 0;
-      sampled = 0;
       for (int v = box.y0; v <= box.y1; v += 2)
         for (int u = box.x0; u <= box.x1; u += 2) {
           if (!mask(u, v)) continue;
-          ++sampled;
           const float z = plane_depth(pc, K, u, v, cos_max, params.max_depth);
-          on += z > 0.0f && on_dilated_footprint(region.footprint, T_wc * (z * K.unproject(float(u), float(v), 1.0f)));
+          on += z > 0.0f && region.footprint.covers(T_wc * (z * K.unproject(float(u), float(v), 1.0f)));
         }
       if (on > best_on) {
         best_on = on;

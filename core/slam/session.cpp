@@ -295,7 +295,9 @@ FrameReport Session::process(const SessionFrame& frame) {
   // does not move the pose, and the depth seen through the glass is no outlier of ICP's: those of
   // the masks' own fill, and those the carried regions will fill after tracking, found here at the
   // predicted pose (the fill itself waits for the tracked one).
-  if (s.config.planes.fill.enabled && !s.config.gt_poses) {
+  const bool fill_pending = s.config.planes.fill.enabled && ((mask_fill && mask_fill->pixels > 0) ||
+                                                              (s.config.planes.fill.carry && !s.fill_regions.empty()));
+  if (fill_pending && !s.config.gt_poses) {
     const auto tf = Clock::now();
     MaskImage blank = mask_fill ? mask_fill->filled : MaskImage(s.K.width, s.K.height, 0);
     if (s.config.planes.fill.carry && !s.fill_regions.empty() && s.frames > 0) {
@@ -355,7 +357,7 @@ FrameReport Session::process(const SessionFrame& frame) {
   // on frames without masks. (A region a mask filled is not applied over it: its footprint, dilated
   // by a cell, would press the wall around the glass onto a plane fitted a little in front of it.)
   std::optional<DeviceImage<float>> fuse_override;  // the filtered depth, filled
-  if (report.state != TrackingState::Lost && s.config.planes.fill.enabled && (mask_fill || s.config.planes.fill.carry)) {
+  if (report.state != TrackingState::Lost && fill_pending) {
     const auto tf = Clock::now();
     const ReflectiveFillParams params = s.config.planes.fill_params();
     DepthImage carried = mask_fill ? std::move(filled) : frame.depth;  // the masks' fill, if any
