@@ -32,7 +32,7 @@ struct TrackOptions {
   io::DatasetFlags flags;
   float voxel = 0.01f, trunc = 0.0f, max_depth = 5.0f;
   int max_frames = 0, progress = 50;
-  bool no_bilateral = false, identity_start = false, fuse_raw = false;
+  bool no_bilateral = false, identity_start = false, fuse_raw = false, no_noise_weighting = false;
   float icp_prior = TrackingParams{}.orb.icp_prior_scale;
 };
 
@@ -56,6 +56,7 @@ void run_track(const TrackOptions& o) {
   TrackingParams params;
   params.mode = parse_tracking_mode(o.mode);
   params.preprocess.bilateral = !o.no_bilateral;
+  params.icp.noise_weighting = !o.no_noise_weighting;
   params.orb.icp_prior_scale = o.icp_prior;
   const Device device = parse_device(o.device);
   const auto dataset = io::open_dataset(o.dataset, o.flags.to_options());
@@ -195,6 +196,8 @@ void register_track_command(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--no-bilateral", opts->no_bilateral, "skip the bilateral depth filter");
+  cmd->add_flag("--no-noise-weighting", opts->no_noise_weighting,
+                "weigh every ICP pair alike instead of by the sensor's depth noise at its depth (ablation)");
   cmd->add_flag("--fuse-raw-depth", opts->fuse_raw,
                 "fuse the raw depth instead of the preprocessed (bilateral-filtered) one (ablation)");
   cmd->add_flag("--identity-start", opts->identity_start, "start at the identity instead of the first ground-truth pose");

@@ -101,7 +101,7 @@ Session::Impl::Impl(SessionConfig c, std::unique_ptr<SemanticCue> cue)
       K(config.K),
       volume(config.tsdf, config.device),
       model(volume, K, volume_mutex),
-      tracker(config.tracking, K, config.device),
+      tracker(config.tracking_params(), K, config.device),
       identifier(config.planes, cue ? std::move(cue) : cue_from_config(config)),
       mapper(config.mapping, K, config.device) {
   if (config.tracking.mode == TrackingMode::IcpOrbMask && !config.gt_poses)

@@ -126,6 +126,12 @@ void ConfigTable::custom(const std::string& name, std::string help, std::functio
   fields.push_back({prefix + name, std::move(help), std::move(get), std::move(set)});
 }
 
+TrackingParams SessionConfig::tracking_params() const {
+  TrackingParams t = tracking;
+  t.icp.noise = planes.segmentation.noise;
+  return t;
+}
+
 void SessionConfig::validate() const {
   if (!K.valid())
     throw std::invalid_argument("config intrinsics: need fx, fy > 0 and a positive image size (got " + K.to_string() + ")");
@@ -136,7 +142,7 @@ void SessionConfig::validate() const {
     throw std::invalid_argument("config intrinsics: principal point (" + float_text(K.cx) + ", " + float_text(K.cy) +
                                 ") is far outside the image");
   tsdf.validate();
-  tracking.validate();
+  tracking_params().validate();
   planes.validate();
   mapping.validate();
   if (plane_period < 1) throw std::invalid_argument("config plane_period: must be >= 1");
@@ -193,6 +199,12 @@ std::vector<ConfigField> config_fields(SessionConfig& c) {
   t.f("tracking.icp.max_distance_m", c.tracking.icp.max_distance_m, "ICP pair distance limit, metres");
   t.f("tracking.icp.max_normal_angle_deg", c.tracking.icp.max_normal_angle_deg, "ICP normal angle limit");
   t.f("tracking.icp.min_inlier_ratio", c.tracking.icp.min_inlier_ratio, "below: ICP failed");
+  t.f("tracking.icp.huber_delta_m", c.tracking.icp.huber_delta_m,
+      "ICP Huber threshold, metres (on residuals scaled to the reference depth's noise)");
+  t.b("tracking.icp.noise_weighting", c.tracking.icp.noise_weighting,
+      "weigh ICP pairs by the sensor noise σ_n(z) (planes.segmentation.noise_*) at their depth");
+  t.f("tracking.icp.noise_reference_depth_m", c.tracking.icp.noise_reference_depth_m,
+      "depth where a pair's noise weight is 1 and Huber sees its residual unscaled, metres");
   t.i("tracking.orb.features", c.tracking.orb.features, "ORB features per frame");
   t.i("tracking.orb.min_inliers", c.tracking.orb.min_inliers, "BA inliers needed to accept ORB refinement");
   t.f("tracking.orb.mask_threshold", c.tracking.orb.mask_threshold, "R^track = mean RGB of C_r > this");

@@ -38,6 +38,9 @@ struct SessionConfig {
 
   // Throws std::invalid_argument naming the first bad field (intrinsics included).
   void validate() const;
+  // `tracking` with the sensor's noise model, planes.segmentation.noise (one sensor: ICP's noise
+  // weighting and plane segmentation assume the same σ_n(z)).
+  TrackingParams tracking_params() const;
 };
 
 // One named field of SessionConfig, typed by its text form.

@@ -37,11 +37,17 @@ kernel::IcpSystem reduce_icp_system(const VertexNormalMaps& source, const IcpMod
       model.normals->width() != model.K.width || model.normals->height() != model.K.height)
     throw std::invalid_argument("icp: model maps do not match the model intrinsics " + model.K.to_string());
   const Eigen::Isometry3f T_ref_cw = model.T_wc.inverse();
-  const kernel::IcpArgs args{source.vertices.view(), source.normals.view(), model.vertices->view(),
-                             model.normals->view(), model.K, T_ref_cw.linear(), T_ref_cw.translation(),
-                             T_wc.linear(), T_wc.translation(), params.max_distance_m,
-                             float(std::cos(params.max_normal_angle_deg * std::numbers::pi / 180.0)),
-                             params.huber_delta_m};
+  kernel::IcpArgs args{source.vertices.view(), source.normals.view(), model.vertices->view(),
+                       model.normals->view(), model.K, T_ref_cw.linear(), T_ref_cw.translation(),
+                       T_wc.linear(), T_wc.translation(), params.max_distance_m,
+                       float(std::cos(params.max_normal_angle_deg * std::numbers::pi / 180.0)),
+                       params.huber_delta_m};
+  if (params.noise_weighting) {
+    args.noise_a = params.noise.a;
+    args.noise_b = params.noise.b;
+    args.noise_z0 = params.noise.z0;
+    args.sigma_ref = params.noise.sigma(params.noise_reference_depth_m);
+  }
   kernel::IcpSystem s;
   RRG_DISPATCH(dev, s = kernel::reduce_icp_cpu(args), s = kernel::reduce_icp_cuda(args));
   return s;
@@ -92,6 +98,7 @@ IcpResult icp_align(const FramePyramid& frame, const IcpModel& model, const Eige
   result.valid = int64_t(s.valid);
   result.inlier_ratio = s.valid > 0 ? float(s.inliers / s.valid) : 0.0f;
   result.rmse_m = s.inliers > 0 ? float(std::sqrt(s.r2 / s.inliers)) : 0.0f;
+  result.rmse_ref_m = s.inliers > 0 ? float(std::sqrt(s.r2_ref / s.inliers)) : 0.0f;
   result.jtj = full_jtj(s);
   if (s.inliers >= kMinPairs) {
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eig(full_jtj(s), Eigen::EigenvaluesOnly);

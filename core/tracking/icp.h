@@ -31,6 +31,8 @@ struct IcpResult {
   int64_t valid = 0;           // level 0 pixels with a vertex and a normal
   float inlier_ratio = 0.0f;   // inliers / valid: the quality measure of the state machine
   float rmse_m = 0.0f;         // RMS point-to-plane residual of the inliers
+  float rmse_ref_m = 0.0f;     // the same of the residuals scaled to the reference noise (= rmse_m
+                               // without noise weighting): the σ that goes with jtj
   float condition = 0.0f;      // λ_min / λ_max of JᵀJ at level 0 (small: degenerate geometry)
   Eigen::Matrix<double, 6, 6> jtj = Eigen::Matrix<double, 6, 6>::Zero();  // Σ w JᵀJ at level 0, final pose
 };

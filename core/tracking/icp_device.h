@@ -15,6 +15,8 @@ struct IcpSystem {
   double jtj[21];    // upper triangle of Σ w JᵀJ, row-major
   double jtr[6];     // Σ w Jᵀ r
   double r2;         // Σ r² (unweighted, for the RMSE)
+  double r2_ref;     // Σ (r s)², s = σ_n(z_ref) / σ_n(z) (1 without noise weighting): the residuals'
+                     // scale in the units the weights of JᵀWJ assume
   double inliers;    // pixels that passed association and rejection
   double valid;      // source pixels with a vertex and a normal
 };
@@ -25,6 +27,7 @@ struct IcpSystemSum {
     for (int k = 0; k < 21; ++k) s.jtj[k] = a.jtj[k] + b.jtj[k];
     for (int k = 0; k < 6; ++k) s.jtr[k] = a.jtr[k] + b.jtr[k];
     s.r2 = a.r2 + b.r2;
+    s.r2_ref = a.r2_ref + b.r2_ref;
     s.inliers = a.inliers + b.inliers;
     s.valid = a.valid + b.valid;
     return s;
@@ -35,7 +38,7 @@ RRG_HD inline IcpSystem icp_system_zero() {
   IcpSystem s;
   for (int k = 0; k < 21; ++k) s.jtj[k] = 0.0;
   for (int k = 0; k < 6; ++k) s.jtr[k] = 0.0;
-  s.r2 = s.inliers = s.valid = 0.0;
+  s.r2 = s.r2_ref = s.inliers = s.valid = 0.0;
   return s;
 }
 
@@ -52,6 +55,9 @@ struct IcpArgs {
   Eigen::Matrix3f R_wc;      // current estimate T_g,k
   Eigen::Vector3f t_wc;
   float max_distance, min_cos, huber_delta;
+  // Noise weighting (IcpParams::noise_weighting): σ_n(z) = noise_a + noise_b (z − noise_z0)² at the
+  // source point's depth z, and σ_n at the reference depth; off when sigma_ref = 0.
+  float noise_a = 0.0f, noise_b = 0.0f, noise_z0 = 0.0f, sigma_ref = 0.0f;
 };
 
 // Rounded single-precision multiply and add that the compiler may not fuse into an FMA. The
@@ -93,7 +99,9 @@ RRG_HD inline void project_round(const Intrinsics& K, const Eigen::Vector3f& p, 
 
 // One pixel u: p = T_g,k V_k^l(u); û = proj(K T_ref⁻¹ p); pair with (q, m) = (V*(û), N*(û)) unless
 // |p − q| > max_distance or ∠(R N_k^l(u), m) exceeds the angle. Residual r = (p − q)·m, Jacobian
-// for the left update T ← exp(ξ) T, ξ = [ρ; φ]:  J = [mᵀ, (p × m)ᵀ]; Huber weight w = min(1, δ/|r|).
+// for the left update T ← exp(ξ) T, ξ = [ρ; φ]:  J = [mᵀ, (p × m)ᵀ]. With noise weighting the
+// residual is scaled to the reference noise, r̃ = r s with s = σ_ref / σ_n(z), and the weight is
+// w = s² min(1, δ/|r̃|) (Huber on r̃); without it s = 1.
 // Adds the pixel's share to s (the valid count, and the normal equations when it is an inlier);
 // accumulating in place keeps the CPU loop free of a 30-double temporary per pixel.
 RRG_HD inline void icp_accumulate(const IcpArgs& a, int64_t i, IcpSystem& s) {
@@ -114,7 +122,13 @@ RRG_HD inline void icp_accumulate(const IcpArgs& a, int64_t i, IcpSystem& s) {
   if (d.squaredNorm() > a.max_distance * a.max_distance) return;
   if ((a.R_wc * n).dot(m) < a.min_cos) return;
   const float r = d.dot(m);
-  const float w = fabsf(r) <= a.huber_delta ? 1.0f : a.huber_delta / fabsf(r);
+  float scale = 1.0f;  // s = σ_ref / σ_n(z)
+  if (a.sigma_ref > 0.0f) {
+    const float dz = v.z() - a.noise_z0;
+    scale = a.sigma_ref / (a.noise_a + a.noise_b * dz * dz);
+  }
+  const float r_ref = r * scale;
+  const float w = scale * scale * (fabsf(r_ref) <= a.huber_delta ? 1.0f : a.huber_delta / fabsf(r_ref));
   const Eigen::Vector3f pm = p.cross(m);
   const float J[6] = {m.x(), m.y(), m.z(), pm.x(), pm.y(), pm.z()};
   int k = 0;
@@ -124,6 +138,7 @@ RRG_HD inline void icp_accumulate(const IcpArgs& a, int64_t i, IcpSystem& s) {
     s.jtr[row] += double(wj * r);
   }
   s.r2 += double(r) * double(r);
+  s.r2_ref += double(r_ref) * double(r_ref);
   s.inliers += 1.0;
 }
 

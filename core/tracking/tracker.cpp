@@ -168,7 +168,7 @@ TrackResult Tracker::track(const TrackInput& in, ModelSource& model, MaskSource*
       const auto obs = to_observations(f, matches, params_.orb);
       PosePrior prior;
       prior.T_wc = r.icp.T_wc.cast<double>();
-      const double sigma = std::max(double(r.icp.rmse_m), 1e-3);
+      const double sigma = std::max(double(r.icp.rmse_ref_m), 1e-3);
       prior.information = double(params_.orb.icp_prior_scale) * r.icp.jtj / (sigma * sigma);
       const BaResult ba = optimize_pose(obs, K_, params_.orb.baseline_fx, prior.T_wc, params_.ba,
                                         params_.orb.icp_prior_scale > 0 ? &prior : nullptr);

@@ -30,6 +30,11 @@ void TrackingParams::validate() const {
   if (!(icp.max_distance_m > 0)) fail("icp.max_distance_m must be > 0");
   if (!(icp.max_normal_angle_deg > 0 && icp.max_normal_angle_deg <= 90)) fail("icp.max_normal_angle_deg must be in (0, 90]");
   if (!(icp.huber_delta_m > 0)) fail("icp.huber_delta_m must be > 0");
+  if (icp.noise_weighting) {
+    if (!icp.noise.valid()) fail("icp.noise must have a, b >= 0 and be finite");
+    if (!(icp.noise_reference_depth_m > 0)) fail("icp.noise_reference_depth_m must be > 0");
+    if (!(icp.noise.sigma(icp.noise_reference_depth_m) > 0)) fail("icp.noise: σ_n at the reference depth must be > 0");
+  }
   if (!(icp.min_inlier_ratio >= 0 && icp.min_inlier_ratio <= icp.ok_inlier_ratio && icp.ok_inlier_ratio <= 1))
     fail("icp inlier ratios must satisfy 0 <= min <= ok <= 1");
   if (orb.features < 10) fail("orb.features must be >= 10");

@@ -1,6 +1,8 @@
 #pragma once
 // Parameters of reflection-aware tracking (paper §4.1.1-4.1.2, DESIGN.md §5) with their defaults,
 // and the ablation switch of the paper's tracking ablation (icp | icp+orb | icp+orb+mask).
+#include "core/common/depth_noise_model.h"
+
 #include <string>
 
 namespace rrg {
@@ -24,6 +26,16 @@ struct IcpParams {
   float max_distance_m = 0.10f;   // reject pairs farther apart (after the current estimate)
   float max_normal_angle_deg = 30.0f;  // reject pairs whose normals differ more
   float huber_delta_m = 0.01f;    // robust weight w = min(1, δ / |r|) on the point-to-plane residual
+                                  // (with noise weighting: on r scaled to the reference depth's noise)
+  // Noise weighting (Nguyen, Izadi & Lovell 2012): each pair's residual is divided by the sensor's
+  // axial noise σ_n(z) at the source point's depth, so a pair 4 m away (σ_n 2.6 cm on a Kinect v1)
+  // counts as the 1/180 of a pair at 1 m (1.9 mm) that its variance says, instead of the same. The
+  // weight is (σ_n(z_ref) / σ_n(z))² and Huber applies to r σ_n(z_ref) / σ_n(z): at the reference
+  // depth both are as without weighting. The model is the sensor's (SessionConfig keeps it equal to
+  // planes.segmentation's).
+  bool noise_weighting = true;
+  float noise_reference_depth_m = 1.0f;
+  DepthNoiseModel noise;
   float min_inlier_ratio = 0.25f; // below: ICP failed (diverged or no overlap)
   float ok_inlier_ratio = 0.50f;  // below (and above min): tracking degraded
   float max_jump_m = 0.30f;       // an ICP step farther than this from the motion prior diverged

@@ -91,6 +91,28 @@ TEST(SessionConfig, OverridesSetFieldsAndRejectNonsense) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("planes.fill.min_region_share"), std::string::npos) << e.what();
   }
+  apply_override(c, "planes.fill.min_region_share=0.5");
+  // ICP's noise weighting: its keys, and the sensor's noise model taken from plane segmentation's.
+  EXPECT_TRUE(c.tracking_params().icp.noise_weighting);
+  apply_override(c, "planes.segmentation.noise_b=0.003");
+  apply_override(c, "tracking.icp.noise_reference_depth_m=2");
+  apply_override(c, "tracking.icp.huber_delta_m=0.02");
+  const TrackingParams t = c.tracking_params();
+  EXPECT_FLOAT_EQ(t.icp.noise.b, 0.003f);
+  EXPECT_FLOAT_EQ(t.icp.noise.a, c.planes.segmentation.noise.a);
+  EXPECT_FLOAT_EQ(t.icp.noise_reference_depth_m, 2.0f);
+  EXPECT_FLOAT_EQ(t.icp.huber_delta_m, 0.02f);
+  c.validate();
+  apply_override(c, "tracking.icp.noise_reference_depth_m=0");
+  try {
+    c.validate();
+    FAIL() << "noise_reference_depth_m 0 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("noise_reference_depth_m"), std::string::npos) << e.what();
+  }
+  apply_override(c, "tracking.icp.noise_weighting=false");
+  EXPECT_FALSE(c.tracking_params().icp.noise_weighting);
+  c.validate();  // the reference depth is not used then
 }
 
 TEST(SessionConfig, YamlFilesAreNestedAndRoundTrip) {

@@ -93,6 +93,50 @@ TEST(Icp, SystemAtTruePoseHasZeroResidualAndKnownCount) {
   EXPECT_LT(xi.norm(), 1e-5);
 }
 
+// One pair by hand: a source point 3 m in front of the camera and its model point on a plane facing
+// it, r metres behind. With noise weighting the pair's weight is s² with s = σ_n(1 m) / σ_n(3 m)
+// = 0.001884 / 0.014044, and Huber sees r s instead of r.
+kernel::IcpSystem one_pair(float r, bool weighting) {
+  IcpParams params;
+  params.noise_weighting = weighting;
+  Image<Eigen::Vector3f> src_v(1, 1, Eigen::Vector3f(0, 0, 3)), src_n(1, 1, Eigen::Vector3f(0, 0, -1));
+  Image<Eigen::Vector3f> mod_v(1, 1, Eigen::Vector3f(0, 0, 3 + r)), mod_n(1, 1, Eigen::Vector3f(0, 0, -1));
+  const VertexNormalMaps source{DeviceImage<Eigen::Vector3f>::from_host(src_v, Device::cpu()),
+                                DeviceImage<Eigen::Vector3f>::from_host(src_n, Device::cpu())};
+  const DeviceImage<Eigen::Vector3f> mv = DeviceImage<Eigen::Vector3f>::from_host(mod_v, Device::cpu());
+  const DeviceImage<Eigen::Vector3f> mn = DeviceImage<Eigen::Vector3f>::from_host(mod_n, Device::cpu());
+  Intrinsics K;
+  K.width = K.height = 1;
+  K.fx = K.fy = 1.0f;
+  K.cx = K.cy = 0.0f;
+  return reduce_icp_system(source, IcpModel{&mv, &mn, K, Eigen::Isometry3f::Identity()}, Eigen::Isometry3f::Identity(), params);
+}
+
+TEST(Icp, NoiseWeightingScalesAPairByTheSensorNoiseAtItsDepth) {
+  const DepthNoiseModel noise;
+  const double s = double(noise.sigma(1.0f)) / double(noise.sigma(3.0f));
+  ASSERT_NEAR(s, 0.001884 / 0.014044, 1e-5);
+  // Inside Huber's quadratic zone: weight 1 without, s² with. J = [m, p × m] with m = (0, 0, −1)
+  // and p × m = 0: the only entries are J_z = −1, so Σ w JᵀJ is w at (2, 2), jtj[11] of the
+  // row-major upper triangle, and Σ w Jᵀr is −w r at index 2 (r = (p − q)·m = the offset).
+  const kernel::IcpSystem off = one_pair(0.002f, false), on = one_pair(0.002f, true);
+  ASSERT_EQ(off.inliers, 1.0);
+  ASSERT_EQ(on.inliers, 1.0);
+  EXPECT_NEAR(off.jtj[11], 1.0, 1e-6);
+  EXPECT_NEAR(on.jtj[11], s * s, 1e-6);
+  EXPECT_NEAR(off.jtr[2], -0.002, 1e-7);
+  EXPECT_NEAR(on.jtr[2], -s * s * 0.002, 1e-7);
+  EXPECT_NEAR(on.r2, 0.002 * 0.002, 1e-9);        // the RMSE stays in metres
+  EXPECT_NEAR(on.r2_ref, (0.002 * s) * (0.002 * s), 1e-10);
+  // Past Huber's threshold (r = 9 cm, r s = 1.2 cm > δ): δ / r without, s δ / r with.
+  const kernel::IcpSystem off9 = one_pair(0.09f, false), on9 = one_pair(0.09f, true);
+  EXPECT_NEAR(off9.jtj[11], 0.01 / 0.09, 1e-5);
+  EXPECT_NEAR(on9.jtj[11], s * 0.01 / 0.09, 1e-5);
+  // A residual of 5 cm at 3 m is 6.7 mm at the reference noise: still quadratic with weighting.
+  EXPECT_NEAR(one_pair(0.05f, true).jtj[11], s * s, 1e-6);
+  EXPECT_NEAR(one_pair(0.05f, false).jtj[11], 0.01 / 0.05, 1e-5);
+}
+
 TEST(Icp, RejectsModelOnAnotherDeviceOrWrongSize) {
   const Scene s;
   const DeviceModel model = upload_model(s.model, Device::cpu());

@@ -44,6 +44,19 @@ TEST(TrackingParams, DefaultsAreValidAndBadFieldsAreNamed) {
   TrackingParams q;
   q.preprocess.levels = 4;
   EXPECT_THROW(q.validate(), std::invalid_argument);
+  TrackingParams n;
+  n.icp.noise_reference_depth_m = 0.0f;
+  EXPECT_THROW(n.validate(), std::invalid_argument);
+  n.icp.noise_reference_depth_m = 1.0f;
+  n.icp.noise.b = -1.0f;
+  try {
+    n.validate();
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("icp.noise"), std::string::npos);
+  }
+  n.icp.noise_weighting = false;  // the model is not used then
+  EXPECT_NO_THROW(n.validate());
 }
 
 TEST(Keyframes, InsertedBeyondDeltaAngleOrDeltaMove) {
