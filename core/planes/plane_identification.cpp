@@ -82,6 +82,10 @@ ReflectiveFillParams IdentificationParams::fill_params() const {
   return f;
 }
 
+RegionMatch IdentificationParams::region_match() const {
+  return {table.max_normal_angle_deg, table.max_distance, table.min_overlap};
+}
+
 void IdentificationParams::validate() const {
   segmentation.validate();
   fill_params().validate();

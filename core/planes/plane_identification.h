@@ -62,6 +62,8 @@ struct IdentificationParams {
   // (reflective_fill.h; the callers that fuse apply it). Its sensor noise is segmentation's.
   ReflectiveFillParams fill;
   ReflectiveFillParams fill_params() const;  // fill with segmentation's noise model
+  // "Same surface" for the fill's carried regions: the plane table's geometric filter and overlap.
+  RegionMatch region_match() const;
   void validate() const;             // throws std::invalid_argument
 };
 

@@ -127,7 +127,8 @@ std::vector<FillRegion> fill_regions(const ReflectiveFillResult& result, std::sp
 // mask short of the glass or over its frame) still finds the surface an earlier mask found. Same
 // surface: the same label, normals within max_normal_angle_deg and each plane's footprint centre
 // within max_distance of the other plane (the global plane table's geometric filter), and more than
-// min_overlap of the carried footprint's cells on the fresh one (one-cell dilation).
+// min_overlap of the carried footprint's cells on the fresh one (one-cell dilation). The defaults are
+// GlobalPlaneParams'; a session takes its table's (IdentificationParams::region_match()).
 struct RegionMatch {
   float max_normal_angle_deg = 10.0f;
   float max_distance = 0.1f;

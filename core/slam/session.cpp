@@ -368,7 +368,9 @@ FrameReport Session::process(const SessionFrame& frame) {
       if (mask_fill) {
         pixels += fill_failed_masks_from_regions(carried, *mask_fill, *masks, s.fill_regions, s.K, report.T_wc, params, written);
         if (mask_fill->pixels > 0)
-          unseen = merge_fill_regions(s.fill_regions, fill_regions(*mask_fill, *masks, s.K, report.T_wc));
+          unseen = merge_fill_regions(
+              s.fill_regions, fill_regions(*mask_fill, *masks, s.K, report.T_wc, s.config.planes.table.cell_size),
+              s.config.planes.region_match());
       }
       if (unseen > 0) {
         const ReflectiveFillResult fr =

@@ -253,6 +253,24 @@ TEST(ReflectiveFill, TheInlierBandUsesSegmentationsNoiseModel) {
   EXPECT_THROW(p.validate(), std::invalid_argument);
 }
 
+// "Same surface" for carried regions is the plane table's test: its defaults, and a session's table
+// settings through IdentificationParams::region_match().
+TEST(ReflectiveFill, RegionsMatchWithThePlaneTablesFilter) {
+  const GlobalPlaneParams table;
+  const RegionMatch defaults;
+  EXPECT_EQ(defaults.max_normal_angle_deg, table.max_normal_angle_deg);
+  EXPECT_EQ(defaults.max_distance, table.max_distance);
+  EXPECT_EQ(defaults.min_overlap, table.min_overlap);
+  IdentificationParams p;
+  p.table.max_normal_angle_deg = 5.0f;
+  p.table.max_distance = 0.2f;
+  p.table.min_overlap = 0.1f;
+  const RegionMatch m = p.region_match();
+  EXPECT_EQ(m.max_normal_angle_deg, 5.0f);
+  EXPECT_EQ(m.max_distance, 0.2f);
+  EXPECT_EQ(m.min_overlap, 0.1f);
+}
+
 TEST(ReflectiveFill, TheSameFillCopiesIntoAnotherDepth) {
   DepthImage depth = wall_with_hole(50, 30, 110, 90);
   const SemanticMask mirror = rect_mask(50, 30, 110, 90);
