@@ -33,7 +33,8 @@ void TrackingParams::validate() const {
   if (icp.noise_weighting) {
     if (!icp.noise.valid()) fail("icp.noise must have a, b >= 0 and be finite");
     if (!(icp.noise_reference_depth_m > 0)) fail("icp.noise_reference_depth_m must be > 0");
-    if (!(icp.noise.sigma(icp.noise_reference_depth_m) > 0)) fail("icp.noise: σ_n at the reference depth must be > 0");
+    // σ_n(z) >= a, its value at z0: a > 0 keeps every pair's weight finite.
+    if (!(icp.noise.a > 0)) fail("icp.noise.a must be > 0 with noise weighting (σ_n(z) >= a divides the residuals)");
   }
   if (!(icp.min_inlier_ratio >= 0 && icp.min_inlier_ratio <= icp.ok_inlier_ratio && icp.ok_inlier_ratio <= 1))
     fail("icp inlier ratios must satisfy 0 <= min <= ok <= 1");
