@@ -15,6 +15,16 @@ SessionConfig camera_config() {
   return c;
 }
 
+// validate() refuses c with an error that names `field`.
+void expect_rejected_naming(const SessionConfig& c, const std::string& field, const std::string& what) {
+  try {
+    c.validate();
+    ADD_FAILURE() << what << " accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+  }
+}
+
 TEST(SessionConfig, DefaultsAreThePapers) {
   SessionConfig c = camera_config();
   EXPECT_NO_THROW(c.validate());
@@ -74,23 +84,13 @@ TEST(SessionConfig, OverridesSetFieldsAndRejectNonsense) {
   EXPECT_FALSE(c.planes.fill.carry);
   EXPECT_EQ(c.planes.fill.min_sides, 3);
   apply_override(c, "planes.fill.min_sides=5");
-  try {
-    c.validate();
-    FAIL() << "min_sides 5 accepted";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("planes.fill.min_sides"), std::string::npos) << e.what();
-  }
+  expect_rejected_naming(c, "planes.fill.min_sides", "min_sides 5");
   apply_override(c, "planes.fill.min_sides=2");
   apply_override(c, "planes.fill.min_region_share=0.7");
   EXPECT_FLOAT_EQ(c.planes.fill.min_region_share, 0.7f);
   c.validate();
   apply_override(c, "planes.fill.min_region_share=1.5");
-  try {
-    c.validate();
-    FAIL() << "min_region_share 1.5 accepted";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("planes.fill.min_region_share"), std::string::npos) << e.what();
-  }
+  expect_rejected_naming(c, "planes.fill.min_region_share", "min_region_share 1.5");
   apply_override(c, "planes.fill.min_region_share=0.5");
   // ICP's noise weighting: its keys, and the sensor's noise model taken from plane segmentation's.
   EXPECT_TRUE(c.tracking_params().icp.noise_weighting);
@@ -104,12 +104,7 @@ TEST(SessionConfig, OverridesSetFieldsAndRejectNonsense) {
   EXPECT_FLOAT_EQ(t.icp.huber_delta_m, 0.02f);
   c.validate();
   apply_override(c, "tracking.icp.noise_reference_depth_m=0");
-  try {
-    c.validate();
-    FAIL() << "noise_reference_depth_m 0 accepted";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("noise_reference_depth_m"), std::string::npos) << e.what();
-  }
+  expect_rejected_naming(c, "noise_reference_depth_m", "noise_reference_depth_m 0");
   apply_override(c, "tracking.icp.noise_weighting=false");
   EXPECT_FALSE(c.tracking_params().icp.noise_weighting);
   c.validate();  // the reference depth is not used then
