@@ -252,4 +252,22 @@ IdentificationResult PlaneIdentifier::identify(const IdentificationFrame& frame,
   return out;
 }
 
+std::set<int> undecided_candidates(const std::set<int>& previous, const IdentificationResult& window,
+                                   const ReflectiveVote& vote, const GlobalPlaneTable& table,
+                                   bool every_plane_is_candidate) {
+  std::set<int> open;
+  if (every_plane_is_candidate) return open;
+  const auto undecided = [&](int id) { return !vote.accepted(id) && vote.history_size(id) < vote.params().windows; };
+  std::set<int> seen;
+  for (const PlaneVerdict& v : window.planes) {
+    seen.insert(v.global_id);
+    if (v.candidate && undecided(v.global_id)) open.insert(v.global_id);
+  }
+  for (const int id : previous) {
+    const int c = table.canonical(id);
+    if (!seen.count(c) && undecided(c)) open.insert(c);
+  }
+  return open;
+}
+
 }  // namespace rrg

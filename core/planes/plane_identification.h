@@ -18,6 +18,7 @@
 #include <Eigen/Geometry>
 
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -104,6 +105,17 @@ struct IdentificationResult {
   std::vector<int32_t> remap;        // id -> canonical id, for TSDF fusion and raycast
   IdentificationTimings timings;
 };
+
+// The planes whose reflection is open after a window: semantic candidates (a reflective
+// category's mask is theirs) that are not in L_ref and have fewer than `vote.params().windows`
+// windows of history. The planes `window` saw are decided by its verdicts; the others of `previous`
+// (the last window's set) stay while their vote stays open, under their canonical ids (`table`:
+// merges). Empty when every plane is a candidate (the `none` cue: candidacy carries no evidence).
+// The session keeps these planes out of the tracking mask's features until the vote decides
+// (docs/tracking.md "Reflections not modelled yet").
+std::set<int> undecided_candidates(const std::set<int>& previous, const IdentificationResult& window,
+                                   const ReflectiveVote& vote, const GlobalPlaneTable& table,
+                                   bool every_plane_is_candidate);
 
 class PlaneIdentifier {
  public:

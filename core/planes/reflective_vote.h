@@ -33,6 +33,7 @@ class ReflectiveVote {
   int reflective_count(int id) const;     // reflective outcomes among the kept history
   int history_size(int id) const;
   const std::set<int>& lookup_table() const { return lookup_; }  // L_ref
+  const ReflectiveVoteParams& params() const { return params_; }
 
  private:
   friend struct PlaneStateIo;  // snapshots (plane_state_io.h)

@@ -141,11 +141,46 @@ RaycastResult Session::Impl::locked_raycast(const Intrinsics& K_, const Eigen::I
 
 // C_r at the ICP pose for the tracking mask (§4.1.2): pass 3 over the plane-id map only, each
 // pixel composited until the mask's test mean RGB > threshold is decided (the mask is the same).
-ColorImage Session::Impl::render_reflection(const Eigen::Isometry3f& T_wc, float stop_mean) {
+// With tracking.orb.mask_unmodelled also the pixels of the planes whose reflection is not modelled
+// yet (unmodelled_planes), from the same raycast's plane-id map.
+ReflectionView Session::Impl::render_reflection(const Eigen::Isometry3f& T_wc, float stop_mean) {
   const auto snap = mapper.snapshot();
-  if (!snap || snap->reflection.size() == 0) return ColorImage(K.width, K.height, Color::Zero());
+  const bool gaussians = snap && snap->reflection.size() > 0;
+  const std::vector<int32_t> unknown =
+      unmodelled_planes(snap ? std::span<const int32_t>(snap->reflection_planes) : std::span<const int32_t>{});
+  ReflectionView view;
+  if (!gaussians && unknown.empty()) {
+    view.color = ColorImage(K.width, K.height, Color::Zero());
+    return view;
+  }
   const RaycastResult rc = locked_raycast(K, T_wc, RaycastOutputs{.color = false, .reflection = true, .normals = false});
-  return mapper.render_reflection(RenderCamera{K, T_wc}, rc.plane_ids, stop_mean);
+  view.color = gaussians ? mapper.render_reflection(RenderCamera{K, T_wc}, rc.plane_ids, stop_mean)
+                         : ColorImage(K.width, K.height, Color::Zero());
+  if (!unknown.empty()) {
+    const Image<int32_t> I = rc.plane_ids.to_host();
+    view.unmodelled = MaskImage(K.width, K.height, 0);
+    for (size_t i = 0; i < I.size(); ++i)
+      view.unmodelled[i] = I[i] > 0 && std::binary_search(unknown.begin(), unknown.end(), I[i]) ? 1 : 0;
+  }
+  return view;
+}
+
+// The planes whose reflection the model cannot render yet, sorted: the semantic candidates whose
+// vote is open, and the accepted planes (L_ref) without reflection Gaussians (`rendered`: the
+// snapshot's distinct plane ids of G_r). None without reflections (the base-only ablation keeps
+// the paper's mask, which is then empty) or with tracking.orb.mask_unmodelled off.
+std::vector<int32_t> Session::Impl::unmodelled_planes(std::span<const int32_t> rendered) const {
+  std::vector<int32_t> ids;
+  if (!config.tracking.orb.mask_unmodelled || !config.mapping.reflections) return ids;
+  ids.assign(undecided.begin(), undecided.end());
+  {
+    std::lock_guard lock(state_mutex);
+    for (const ReflectivePlane& p : reflective)
+      if (!std::binary_search(rendered.begin(), rendered.end(), p.id)) ids.push_back(p.id);
+  }
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  return ids;
 }
 
 MappingContext Session::Impl::mapping_context() {
@@ -182,6 +217,8 @@ void Session::Impl::identify(const SessionFrame& frame, const DepthImage& depth,
                         config.tsdf.voxel_size, masks};
   if (identifier.cue().name() == "labels" && !frame.labels) f.labels = nullptr;
   IdentificationResult r = identifier.identify(f, cvar);
+  undecided = undecided_candidates(undecided, r, identifier.vote(), identifier.table(),
+                                   identifier.cue().every_plane_is_candidate());
   plane_ids = DeviceImage<int32_t>::from_host(r.global_map, config.device);
   mask = DeviceImage<uint8_t>::from_host(r.reflection_mask, config.device);
   std::vector<ReflectivePlane> accepted;
@@ -344,6 +381,7 @@ FrameReport Session::process(const SessionFrame& frame) {
     report.times.preprocess = r.ms_preprocess;
     report.times.icp = r.ms_icp;
     report.times.orb = r.ms_orb;
+    report.tracking_mask_pixels = r.mask_pixels;
     keyframe = r.keyframe || r.first;
   }
   if (D_k == &tracked) D_k = &frame.depth;  // the map takes the frame, filled below, not what tracking saw

@@ -66,6 +66,7 @@ struct FrameReport {
   bool identified = false;         // plane identification ran on this frame
   float exposure_gain = 1.0f;      // its exposure against the map, fused into C_var (1: none estimated)
   int64_t filled_pixels = 0;       // depth pixels filled on reflective masks (planes.fill)
+  int64_t tracking_mask_pixels = 0; // R_k^track's pixels kept out of ORB (icp+orb+mask)
   bool mapping_started = false;    // a mapping step was started (async) or run (sync) after it
   uint64_t map_version = 0;        // after this frame
   std::string note;                // tracking note

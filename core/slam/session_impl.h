@@ -19,6 +19,8 @@
 #include "core/tsdf/tsdf_volume.h"
 
 #include <atomic>
+#include <set>
+#include <span>
 #include <condition_variable>
 #include <mutex>
 #include <shared_mutex>
@@ -77,7 +79,8 @@ struct Session::Impl {
   RaycastResult locked_raycast(const Intrinsics& K, const Eigen::Isometry3f& T_wc,
                                RaycastOutputs outputs = RaycastOutputs::all()) const;
   // C_r for the tracking mask, exact where its mean RGB stays <= stop_mean (the mask's threshold)
-  ColorImage render_reflection(const Eigen::Isometry3f& T_wc, float stop_mean);
+  ReflectionView render_reflection(const Eigen::Isometry3f& T_wc, float stop_mean);
+  std::vector<int32_t> unmodelled_planes(std::span<const int32_t> rendered) const;
   std::vector<int32_t> remap_copy() const {
     std::lock_guard lock(state_mutex);
     return remap;
@@ -108,6 +111,9 @@ struct Session::Impl {
   // The last fill's surfaces (world frame), for frames without masks (planes.fill). Saved in
   // snapshots (the continuation section).
   std::vector<FillRegion> fill_regions;
+  // Planes a semantic cue calls reflective whose vote is still open (undecided_candidates), kept out
+  // of the tracking mask's features with tracking.orb.mask_unmodelled; pre-mapping thread.
+  std::set<int> undecided;
   MappingSummary mapping;
   std::atomic<uint64_t> map_version{0};
   TrackingState state = TrackingState::Ok;

@@ -137,6 +137,7 @@ void Session::save(const std::filesystem::path& file) const {
       c.pending_keyframe.push_back(s.pending_keyframe[i] ? 1 : 0);
     }
     c.fill_regions = s.fill_regions;
+    c.undecided_planes.assign(s.undecided.begin(), s.undecided.end());
     const std::vector<uint8_t> section = write_continuation(c);
     continuation_bytes = section.size();
     stored_frames = c.mapper.frames.size() + c.pending.size();
@@ -280,6 +281,7 @@ std::unique_ptr<Session> Session::load(const std::filesystem::path& file, std::u
     }
     s.tracker_keyframes = s.tracker.keyframes().size();
     s.fill_regions = std::move(c.fill_regions);
+    s.undecided = std::set<int>(c.undecided_planes.begin(), c.undecided_planes.end());
   } else {
     spdlog::info("{}: format v1 has no keyframes, motion or optimiser state; tracking resumes from the last pose "
                  "and mapping from the frames that follow", what);

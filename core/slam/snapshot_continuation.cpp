@@ -13,7 +13,7 @@
 namespace rrg {
 namespace {
 
-constexpr uint32_t kSectionVersion = 2;  // 1: no fill regions (still read)
+constexpr uint32_t kSectionVersion = 3;  // 1: no fill regions, 2: no undecided planes (both still read)
 constexpr int kZstdLevel = 3;
 
 // raw size, then one zstd frame
@@ -141,13 +141,14 @@ std::vector<uint8_t> write_continuation(const ContinuationState& s) {
   for (const CompactFrame& f : s.pending) put_frame(w, f);
   w.put_vector(s.pending_keyframe);
   PlaneStateIo::write_fill_regions(w, s.fill_regions);
+  w.put_vector(s.undecided_planes);
   return std::move(w.bytes());
 }
 
 ContinuationState read_continuation(std::span<const uint8_t> bytes, const std::string& what) {
   io::ByteReader r(bytes, what + " (continuation)");
   const auto version = r.get<uint32_t>();
-  if (version != 1 && version != kSectionVersion)
+  if (version < 1 || version > kSectionVersion)
     throw std::runtime_error(r.what() + ": unsupported section version " + std::to_string(version));
   ContinuationState s;
   s.tracker = read_tracker_state(r);
@@ -165,6 +166,7 @@ ContinuationState read_continuation(std::span<const uint8_t> bytes, const std::s
   if (s.pending_keyframe.size() != s.pending.size())
     throw std::runtime_error(r.what() + ": pending frames and keyframe flags differ in number");
   if (version >= 2) s.fill_regions = PlaneStateIo::read_fill_regions(r);
+  if (version >= 3) s.undecided_planes = r.get_vector<int32_t>();
   if (r.remaining() != 0) throw std::runtime_error(r.what() + ": " + std::to_string(r.remaining()) + " trailing bytes");
   return s;
 }

@@ -6,7 +6,8 @@
 //   the mapper's state (step counter, stored keyframes and frames since the last step, both sets'
 //   Adam moments and step counts),
 //   the session's fused frames not yet handed to the mapper (with their keyframe flags),
-//   the reflective fill's carried surfaces (section v2; a v1 section has none).
+//   the reflective fill's carried surfaces (section v2; a v1 section has none),
+//   the planes whose reflection vote is open, kept out of the tracking mask's features (v3).
 // Frames are stored in the mapper's compact form (8-bit colour: zstd; 1/5000 m depth: RVL+zstd),
 // Adam moments as byte planes + zstd: all bit-exact.
 #include "core/io/byte_stream.h"
@@ -27,6 +28,7 @@ struct ContinuationState {
   std::vector<CompactFrame> pending;     // fused, not yet given to the mapper
   std::vector<uint8_t> pending_keyframe;  // one flag per pending frame
   std::vector<FillRegion> fill_regions;   // planes.fill.carry: what frames without masks fill from
+  std::vector<int32_t> undecided_planes;  // semantic candidates with an open vote (tracking.orb.mask_unmodelled)
 };
 
 std::vector<uint8_t> write_continuation(const ContinuationState& state);

@@ -14,7 +14,14 @@ MaskImage tracking_mask_from_reflection(const ColorImage& reflection_color, floa
 }
 
 MaskImage RenderedReflectionMasks::mask(size_t frame_index, const Eigen::Isometry3f& T_wc_icp) {
-  return tracking_mask_from_reflection(render_(frame_index, T_wc_icp, threshold_), threshold_);
+  const ReflectionView view = render_(frame_index, T_wc_icp, threshold_);
+  MaskImage mask = tracking_mask_from_reflection(view.color, threshold_);
+  if (!view.unmodelled.empty()) {
+    if (!view.unmodelled.same_size(mask))
+      throw std::invalid_argument("tracking mask: the unmodelled-reflection mask is not the size of C_r");
+    for (size_t i = 0; i < mask.size(); ++i) mask[i] |= view.unmodelled[i] ? 1 : 0;
+  }
+  return mask;
 }
 
 SynthReflectionMasks::SynthReflectionMasks(std::filesystem::path root) : root_(std::move(root)) {

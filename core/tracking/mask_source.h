@@ -21,13 +21,22 @@ class MaskSource {
 // R^track(u) = (C_r,r + C_r,g + C_r,b) / 3 > threshold.
 MaskImage tracking_mask_from_reflection(const ColorImage& reflection_color, float threshold = 0.1f);
 
-// Renders C_r with a callback (the reflection Gaussians) and thresholds it. The callback gets the
-// threshold: C_r only needs to be exact where its mean RGB stays at or below it (a renderer may stop
-// a pixel once it is above, Renderer::render_reflection's stop_mean), so the stop and the test are
-// one value.
+// What a reflection renderer gives the mask at a pose: C_r, and the pixels whose reflection the
+// model cannot render yet (a session's planes that a semantic cue calls reflective and whose vote
+// is still open, or accepted planes without reflection Gaussians so far: docs/tracking.md
+// "Reflections not modelled yet"). Both are kept out of ORB.
+struct ReflectionView {
+  ColorImage color;      // C_r
+  MaskImage unmodelled;  // non-zero: reflection not modelled yet; empty: none
+};
+
+// Renders C_r with a callback (the reflection Gaussians) and thresholds it, or'ed with the view's
+// unmodelled pixels. The callback gets the threshold: C_r only needs to be exact where its mean RGB
+// stays at or below it (a renderer may stop a pixel once it is above,
+// Renderer::render_reflection's stop_mean), so the stop and the test are one value.
 class RenderedReflectionMasks final : public MaskSource {
  public:
-  using Renderer = std::function<ColorImage(size_t frame_index, const Eigen::Isometry3f& T_wc, float threshold)>;
+  using Renderer = std::function<ReflectionView(size_t frame_index, const Eigen::Isometry3f& T_wc, float threshold)>;
   RenderedReflectionMasks(Renderer render, float threshold) : render_(std::move(render)), threshold_(threshold) {}
   MaskImage mask(size_t frame_index, const Eigen::Isometry3f& T_wc_icp) override;
 

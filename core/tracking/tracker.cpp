@@ -6,6 +6,7 @@
 #include "core/tracking/relocalization.h"
 #include "core/tracking/se3.h"
 
+#include <algorithm>
 #include <spdlog/spdlog.h>
 
 #include <chrono>
@@ -95,7 +96,10 @@ TrackResult Tracker::track(const TrackInput& in, ModelSource& model, MaskSource*
     if (!orb) {
       const auto t0 = Clock::now();
       std::optional<MaskImage> mask;
-      if (use_mask) mask = masks->mask(in.index, T_wc);
+      if (use_mask) {
+        mask = masks->mask(in.index, T_wc);
+        r.mask_pixels = std::count_if(mask->pixels().begin(), mask->pixels().end(), [](uint8_t m) { return m != 0; });
+      }
       orb = extract_orb(*in.color, *in.depth, K_, mask ? &*mask : nullptr, params_.orb);
       r.orb_keypoints = int(orb->keypoints.size());
       r.ms_orb += ms_since(t0);

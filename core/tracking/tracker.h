@@ -41,6 +41,7 @@ struct TrackResult {
   IcpResult icp;                // stage 1
   bool orb_refined = false;     // stage 2 changed the pose
   int orb_keypoints = 0, orb_matches = 0, orb_inliers = 0;
+  int64_t mask_pixels = 0;      // R_k^track's pixels (icp+orb+mask), kept out of ORB
   bool relocalised = false;
   bool keyframe = false;        // a keyframe was inserted
   std::string note;             // why stage 2 was skipped / rejected, relocalisation, ...

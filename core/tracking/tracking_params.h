@@ -61,6 +61,10 @@ struct OrbParams {
   float max_correction_m = 0.05f; // a BA result farther than this from the ICP pose is rejected
   float max_correction_deg = 3.0f;
   float mask_threshold = 0.1f;    // R_k^track = mean RGB of C_r > 0.1
+  // A session also keeps out the planes whose reflection is not modelled yet: semantic candidates
+  // with an open vote, accepted planes without reflection Gaussians (docs/tracking.md "Reflections
+  // not modelled yet"). false: the paper's C_r test alone.
+  bool mask_unmodelled = true;
   float icp_prior_scale = 1e-3f;  // s of the ICP prior Λ = s JᵀJ_icp / σ_icp² in the BA (0 = none);
                                   // s < 1 because neighbouring ICP residuals are correlated
   // Consistency gate: the BA correction Δ = log(T_ba T_icp⁻¹) must satisfy Δᵀ Λ Δ <= χ²₆(99 %)

@@ -1,6 +1,8 @@
 // The 5-window vote: accepted into L_ref when reflective in more than 3 of the last 5 windows.
 #include "core/planes/reflective_vote.h"
 
+#include "core/planes/plane_identification.h"
+
 #include <gtest/gtest.h>
 
 namespace rrg {
@@ -49,6 +51,60 @@ TEST(ReflectiveVote, SameWindowOrsAndMergePoolsHistories) {
 TEST(ReflectiveVote, BadParamsThrow) {
   EXPECT_THROW(ReflectiveVote(ReflectiveVoteParams{5, 6}), std::invalid_argument);
   EXPECT_THROW(ReflectiveVote(ReflectiveVoteParams{0, 1}), std::invalid_argument);
+}
+
+// The planes whose reflection stays open for the tracking mask: semantic candidates without a
+// decision, carried across windows that do not see them until their history is full.
+TEST(ReflectiveVote, UndecidedCandidatesAreTheSemanticCandidatesWithAnOpenVote) {
+  ReflectiveVote vote;
+  const GlobalPlaneTable table;  // no merges: every id is its own canonical id
+  IdentificationResult w;
+  const auto verdict = [](int id, bool candidate) {
+    PlaneVerdict v;
+    v.global_id = id;
+    v.candidate = candidate;
+    return v;
+  };
+  // Window 0 sees a mirror (candidate) and a wall (no reflective mask); neither is reflective yet.
+  w.planes = {verdict(1, true), verdict(2, false)};
+  vote.record(1, 0, false);
+  vote.record(2, 0, false);
+  std::set<int> open = undecided_candidates({}, w, vote, table, false);
+  EXPECT_EQ(open, std::set<int>({1}));
+  EXPECT_TRUE(undecided_candidates({}, w, vote, table, true).empty()) << "`none`: candidacy says nothing";
+
+  // Windows 1-3 do not see plane 1: it stays open while its history is short.
+  for (int64_t k = 1; k <= 3; ++k) {
+    w.planes = {verdict(2, false)};
+    vote.record(2, k, false);
+    open = undecided_candidates(open, w, vote, table, false);
+  }
+  EXPECT_EQ(open, std::set<int>({1}));
+
+  // Reflective in windows 4-7: accepted after four of five, which closes it.
+  for (int64_t k = 4; k <= 7; ++k) {
+    w.planes = {verdict(1, true)};
+    const bool accepted = vote.record(1, k, true);
+    open = undecided_candidates(open, w, vote, table, false);
+    EXPECT_EQ(open.count(1), accepted ? 0u : 1u) << "window " << k;
+  }
+  EXPECT_TRUE(vote.accepted(1));
+
+  // A candidate that is never reflective closes once its history is full (five windows).
+  for (int64_t k = 8; k <= 12; ++k) {
+    w.planes = {verdict(3, true)};
+    vote.record(3, k, false);
+    open = undecided_candidates(open, w, vote, table, false);
+    EXPECT_EQ(open.count(3), k < 12 ? 1u : 0u) << "window " << k;
+  }
+  // A plane seen as no candidate in a window is decided by that window.
+  w.planes = {verdict(4, true)};
+  vote.record(4, 13, false);
+  open = undecided_candidates(open, w, vote, table, false);
+  ASSERT_EQ(open.count(4), 1u);
+  w.planes = {verdict(4, false)};
+  vote.record(4, 14, false);
+  EXPECT_EQ(undecided_candidates(open, w, vote, table, false).count(4), 0u);
 }
 
 }  // namespace

@@ -126,9 +126,26 @@ TEST(MaskSource, TrackingMaskThresholdsMeanReflectionColour) {
   EXPECT_EQ(m(1, 0), 1);
   EXPECT_EQ(m(2, 0), 0);
   float passed = -1.0f;  // the render callback gets the mask's threshold (its stop, mask_source.h)
-  RenderedReflectionMasks source([&](size_t, const Eigen::Isometry3f&, float t) { passed = t; return c; }, 0.05f);
-  EXPECT_EQ(source.mask(0, Eigen::Isometry3f::Identity())(0, 0), 1);
+  RenderedReflectionMasks source([&](size_t, const Eigen::Isometry3f&, float t) {
+    passed = t;
+    return ReflectionView{c, {}};
+  }, 0.05f);
+  const MaskImage rendered = source.mask(0, Eigen::Isometry3f::Identity());
   EXPECT_EQ(passed, 0.05f);
+  EXPECT_EQ(rendered(0, 0), 1);  // mean 0.1 > 0.05
+  EXPECT_EQ(rendered(2, 0), 0);
+  // Pixels whose reflection is not modelled yet join the mask whatever C_r says there.
+  MaskImage unmodelled(3, 1, 0);
+  unmodelled(2, 0) = 1;
+  RenderedReflectionMasks with_unknown([&](size_t, const Eigen::Isometry3f&, float) { return ReflectionView{c, unmodelled}; },
+                                       0.1f);
+  const MaskImage both = with_unknown.mask(0, Eigen::Isometry3f::Identity());
+  EXPECT_EQ(both(0, 0), 0);
+  EXPECT_EQ(both(1, 0), 1);
+  EXPECT_EQ(both(2, 0), 1);
+  RenderedReflectionMasks wrong_size([&](size_t, const Eigen::Isometry3f&, float) { return ReflectionView{c, MaskImage(2, 1, 1)}; },
+                                     0.1f);
+  EXPECT_THROW(wrong_size.mask(0, Eigen::Isometry3f::Identity()), std::invalid_argument);
   EXPECT_THROW(SynthReflectionMasks("/nonexistent/folder"), std::runtime_error);
 }
 
