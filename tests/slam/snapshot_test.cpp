@@ -173,6 +173,33 @@ TEST_F(SnapshotTest, CarriedFillSurfacesSurviveALoad) {
   EXPECT_EQ(whole.status().tsdf_blocks, loaded->status().tsdf_blocks);
 }
 
+// The planes whose reflection vote is open are in the snapshot (continuation v3): the loaded
+// session keeps them out of ORB on the next frames as the uninterrupted one does; without them it
+// would mask nothing until the next identification frame.
+TEST_F(SnapshotTest, UndecidedCandidatesSurviveALoad) {
+  const auto d = io::open_dataset(root());
+  test::TempDir dir("snap-undecided");
+  SessionConfig c = base_config(*d);
+  c.tracking.mode = TrackingMode::IcpOrbMask;
+  c.plane_period = 10;
+  constexpr size_t kAt = 3, kEnd = 6;
+  const auto f = [&](size_t i) { return SynthSessionTest::frame(*d, i, i == 0); };
+  Session whole(c);
+  std::vector<int64_t> expected;
+  for (size_t i = 0; i < kEnd; ++i) expected.push_back(whole.process(f(i)).tracking_mask_pixels);
+  std::unique_ptr<Session> loaded;
+  {
+    Session first(c);
+    for (size_t i = 0; i < kAt; ++i) first.process(f(i));
+    first.save(dir / "s.rrgs");
+    loaded = Session::load(dir / "s.rrgs");
+  }
+  for (size_t i = kAt; i < kEnd; ++i) {
+    ASSERT_GT(expected[i], 0) << "frame " << i << " masks the open candidates";
+    EXPECT_EQ(loaded->process(f(i)).tracking_mask_pixels, expected[i]) << "frame " << i;
+  }
+}
+
 TEST_F(SnapshotTest, VersionOneFilesStillLoadAndContinue) {
   const auto d = io::open_dataset(root());
   test::TempDir dir("snap-v1");
