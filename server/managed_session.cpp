@@ -140,6 +140,7 @@ void ManagedSession::run_one(Item& item) {
     r.set_fused(report.fused);
     r.set_note(report.note);
     r.set_filled_pixels(uint32_t(report.filled_pixels));
+    r.set_tracking_mask_pixels(uint32_t(report.tracking_mask_pixels));
     if (!item.frame.render.empty()) {
       const SessionView view = session_->render(session_->config().K, report.T_wc);
       *r.mutable_view() = encode_view(view, item.frame.render);

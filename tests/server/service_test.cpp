@@ -61,8 +61,8 @@ TEST(Service, StreamGivesTheInProcessSessionsTrajectory) {
 }
 
 // A sensor that loses the mirror's depth: the session fills it from the wall around the mirror
-// (labels sent with the frames) and each FrameResult says how many pixels, as the in-process
-// Session does on the same frames.
+// (labels sent with the frames) and each FrameResult says how many pixels, and how many it kept
+// out of ORB, as the in-process Session does on the same frames.
 TEST(Service, FramesReportTheDepthFilledOnALostMirror) {
   TempDir dir("rrg-lost-mirror");
   const auto synth = run_rrg("synth --preset mirror_room --frames 6 --width 160 --height 120 --novel 0 --threads 2 "
@@ -86,13 +86,16 @@ TEST(Service, FramesReportTheDepthFilledOnALostMirror) {
       service::StreamOptions{});
   ASSERT_TRUE(sum.status.ok()) << sum.status.error_message();
   ASSERT_EQ(results.size(), frames.size());
-  uint64_t filled = 0;
+  uint64_t filled = 0, masked = 0;
   for (const auto& r : results) {
     ASSERT_FALSE(r.has_error()) << r.error().message();
     EXPECT_EQ(int64_t(r.filled_pixels()), expected[r.id()].filled_pixels) << "frame " << r.id();
+    EXPECT_EQ(int64_t(r.tracking_mask_pixels()), expected[r.id()].tracking_mask_pixels) << "frame " << r.id();
     filled += r.filled_pixels();
+    masked += r.tracking_mask_pixels();
   }
   EXPECT_GT(filled, 1000u) << "nothing filled on a mirror without depth";
+  EXPECT_GT(masked, 1000u) << "the mirror's plane, a candidate with an open vote, is not kept out of ORB";
   c.close(h);
 }
 
