@@ -147,7 +147,8 @@ TEST(Icp, RejectsModelOnAnotherDeviceOrWrongSize) {
   EXPECT_THROW(reduce_icp_system(pyr.levels[0].maps, none, s.T_ref, IcpParams{}), std::invalid_argument);
 }
 
-// The reduced 6x6 system (21 + 6 + 3 numbers) at a perturbed pose, on every device.
+// The reduced 6x6 system (21 + 6 + 4 numbers: JᵀJ, Jᵀr, r2, r2_ref, inliers, valid) at a perturbed
+// pose, on every device.
 std::vector<double> reduced_system(const Device& device) {
   const Scene s;
   const DeviceModel model = upload_model(s.model, device);
@@ -161,6 +162,7 @@ std::vector<double> reduced_system(const Device& device) {
     out.insert(out.end(), sys.jtj, sys.jtj + 21);
     out.insert(out.end(), sys.jtr, sys.jtr + 6);
     out.push_back(sys.r2);
+    out.push_back(sys.r2_ref);  // the ORB prior's σ (noise weighting, on by default)
     out.push_back(sys.inliers);
     out.push_back(sys.valid);
   }
@@ -169,9 +171,11 @@ std::vector<double> reduced_system(const Device& device) {
 
 TEST(Icp, ReducedSystemDeviceParity) {
   const std::vector<double> cpu = test::expect_device_parity<double>(reduced_system, 1e-4, 1e-4);
-  ASSERT_EQ(cpu.size(), 90u);
-  EXPECT_GT(cpu[29], 1000.0);  // level 0 has thousands of valid pixels
-  EXPECT_GT(cpu[28], 100.0);   // and inliers
+  ASSERT_EQ(cpu.size(), 93u);
+  EXPECT_GT(cpu[30], 1000.0);  // level 0 has thousands of valid pixels
+  EXPECT_GT(cpu[29], 100.0);   // and inliers
+  EXPECT_GT(cpu[28], 0.0);     // r2_ref: weighted residuals
+  EXPECT_NE(cpu[28], cpu[27]); // scaled to the reference depth's noise, not r2 itself
 }
 
 // What the reduced system is for: the Gauss-Newton step ξ it solves to, per level, on every
