@@ -153,15 +153,28 @@ ReflectionView Session::Impl::render_reflection(const Eigen::Isometry3f& T_wc, f
     view.color = ColorImage(K.width, K.height, Color::Zero());
     return view;
   }
-  const RaycastResult rc = locked_raycast(K, T_wc, RaycastOutputs{.color = false, .reflection = true, .normals = false});
-  view.color = gaussians ? mapper.render_reflection(RenderCamera{K, T_wc}, rc.plane_ids, stop_mean)
-                         : ColorImage(K.width, K.height, Color::Zero());
+  // At 1/f of the frame's size (tracking.orb.mask_downsample), then each pixel to its f x f block.
+  const int f = config.tracking.orb.mask_downsample;
+  const Intrinsics Ks = f == 1 ? K : K.scaled(std::max(1, K.width / f), std::max(1, K.height / f));
+  const RaycastResult rc = locked_raycast(Ks, T_wc, RaycastOutputs{.color = false, .reflection = true, .normals = false});
+  const ColorImage C_r = gaussians ? mapper.render_reflection(RenderCamera{Ks, T_wc}, rc.plane_ids, stop_mean)
+                                   : ColorImage(Ks.width, Ks.height, Color::Zero());
+  MaskImage unmodelled;
   if (!unknown.empty()) {
     const Image<int32_t> I = rc.plane_ids.to_host();
-    view.unmodelled = MaskImage(K.width, K.height, 0);
+    unmodelled = MaskImage(Ks.width, Ks.height, 0);
     for (size_t i = 0; i < I.size(); ++i)
-      view.unmodelled[i] = I[i] > 0 && std::binary_search(unknown.begin(), unknown.end(), I[i]) ? 1 : 0;
+      unmodelled[i] = I[i] > 0 && std::binary_search(unknown.begin(), unknown.end(), I[i]) ? 1 : 0;
   }
+  if (f == 1) return ReflectionView{C_r, std::move(unmodelled)};
+  view.color = ColorImage(K.width, K.height);
+  if (!unmodelled.empty()) view.unmodelled = MaskImage(K.width, K.height, 0);
+  for (int v = 0; v < K.height; ++v)
+    for (int u = 0; u < K.width; ++u) {
+      const int us = std::min(u / f, Ks.width - 1), vs = std::min(v / f, Ks.height - 1);
+      view.color(u, v) = C_r(us, vs);
+      if (!unmodelled.empty()) view.unmodelled(u, v) = unmodelled(us, vs);
+    }
   return view;
 }
 

@@ -44,6 +44,7 @@ void TrackingParams::validate() const {
   if (!(orb.icp_consistency_chi2 > 0)) fail("orb.icp_consistency_chi2 must be > 0");
   if (orb.window_keyframes < 1) fail("orb.window_keyframes must be >= 1");
   if (orb.min_inliers < 6) fail("orb.min_inliers must be >= 6");
+  if (orb.mask_downsample < 1 || orb.mask_downsample > 8) fail("orb.mask_downsample must be in [1, 8]");
   if (ba.rounds < 1 || ba.iterations < 1) fail("ba.rounds and ba.iterations must be >= 1");
   if (!(keyframes.delta_angle_deg > 0) || !(keyframes.delta_move_m > 0)) fail("keyframe thresholds must be > 0");
   if (keyframes.max_keyframes < 1) fail("keyframes.max_keyframes must be >= 1");

@@ -65,6 +65,10 @@ struct OrbParams {
   // with an open vote, accepted planes without reflection Gaussians (docs/tracking.md "Reflections
   // not modelled yet"). false: the paper's C_r test alone.
   bool mask_unmodelled = true;
+  // A session can render R_k^track at 1/mask_downsample of the frame's width and height, each of
+  // its pixels then covering f × f frame pixels, at 1/f² of the raycast and render; ORB dilates the
+  // mask by 7 px (orb_features.cpp). 1 (default) = full resolution, as the paper (docs/tracking.md).
+  int mask_downsample = 1;
   float icp_prior_scale = 1e-3f;  // s of the ICP prior Λ = s JᵀJ_icp / σ_icp² in the BA (0 = none);
                                   // s < 1 because neighbouring ICP residuals are correlated
   // Consistency gate: the BA correction Δ = log(T_ba T_icp⁻¹) must satisfy Δᵀ Λ Δ <= χ²₆(99 %)

@@ -278,16 +278,19 @@ TEST_F(SessionTest, TheTrackingMaskKeepsOutReflectionsNotModelledYet) {
     candidates += l != 0 && reflective.count(l);
   }
   ASSERT_GT(mirror, int64_t(f1.depth.size() / 10));
-  for (const bool unmodelled : {true, false}) {
-    SCOPED_TRACE(unmodelled ? "mask_unmodelled" : "C_r test alone");
+  std::map<int, int64_t> masked;  // by mask_downsample
+  for (const auto& [unmodelled, downsample] : {std::pair{true, 1}, std::pair{true, 2}, std::pair{false, 2}}) {
+    SCOPED_TRACE((unmodelled ? "mask_unmodelled, downsample " : "C_r test alone, downsample ") + std::to_string(downsample));
     SessionConfig c = config(*d);
     c.tracking.mode = TrackingMode::IcpOrbMask;
     c.tracking.orb.mask_unmodelled = unmodelled;
+    c.tracking.orb.mask_downsample = downsample;
     Session s(c);
     ASSERT_TRUE(s.process(frame(*d, 0, true)).identified);
     const FrameReport r = s.process(f1);
     EXPECT_EQ(r.state, TrackingState::Ok) << r.note;
     if (unmodelled) {
+      masked[downsample] = r.tracking_mask_pixels;
       EXPECT_GT(r.tracking_mask_pixels, mirror * 9 / 10) << "the mirror's plane is masked";
       // (+25 %: a raycast pixel takes the plane id of its nearest voxel, 2 cm here, so the planes
       // spill over their labels' borders by about a voxel.)
@@ -296,6 +299,8 @@ TEST_F(SessionTest, TheTrackingMaskKeepsOutReflectionsNotModelledYet) {
       EXPECT_EQ(r.tracking_mask_pixels, 0);
     }
   }
+  // Rendered at half the size, each mask pixel covering 2 x 2: the same area to within its border.
+  EXPECT_NEAR(double(masked[2]), double(masked[1]), 0.05 * double(masked[1]));
 }
 
 TEST_F(SessionTest, TracksTheSequence) {
