@@ -6,9 +6,9 @@
 #include "core/tracking/relocalization.h"
 #include "core/tracking/se3.h"
 
-#include <algorithm>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <numbers>
 #include <optional>
