@@ -43,9 +43,7 @@ kernel::IcpSystem reduce_icp_system(const VertexNormalMaps& source, const IcpMod
                        float(std::cos(params.max_normal_angle_deg * std::numbers::pi / 180.0)),
                        params.huber_delta_m};
   if (params.noise_weighting) {
-    args.noise_a = params.noise.a;
-    args.noise_b = params.noise.b;
-    args.noise_z0 = params.noise.z0;
+    args.noise = params.noise;
     args.sigma_ref = params.noise.sigma(params.noise_reference_depth_m);
   }
   kernel::IcpSystem s;

@@ -2,6 +2,7 @@
 // Per-pixel math of frame-to-model point-to-plane ICP (paper §4.1.2, stage 1), shared by both back
 // ends: the only copy. The reduction struct holds the upper triangle of JᵀWJ, JᵀWr and statistics.
 #include "core/common/camera.h"
+#include "core/common/depth_noise_model.h"
 #include "core/common/hd.h"
 #include "core/common/span.h"
 
@@ -55,9 +56,10 @@ struct IcpArgs {
   Eigen::Matrix3f R_wc;      // current estimate T_g,k
   Eigen::Vector3f t_wc;
   float max_distance, min_cos, huber_delta;
-  // Noise weighting (IcpParams::noise_weighting): σ_n(z) = noise_a + noise_b (z − noise_z0)² at the
-  // source point's depth z, and σ_n at the reference depth; off when sigma_ref = 0.
-  float noise_a = 0.0f, noise_b = 0.0f, noise_z0 = 0.0f, sigma_ref = 0.0f;
+  // Noise weighting (IcpParams::noise_weighting): σ_n(z) of the sensor at the source point's depth
+  // z, and σ_n at the reference depth; off when sigma_ref = 0.
+  DepthNoiseModel noise;
+  float sigma_ref = 0.0f;
 };
 
 // Rounded single-precision multiply and add that the compiler may not fuse into an FMA. The
@@ -123,10 +125,7 @@ RRG_HD inline void icp_accumulate(const IcpArgs& a, int64_t i, IcpSystem& s) {
   if ((a.R_wc * n).dot(m) < a.min_cos) return;
   const float r = d.dot(m);
   float scale = 1.0f;  // s = σ_ref / σ_n(z)
-  if (a.sigma_ref > 0.0f) {
-    const float dz = v.z() - a.noise_z0;
-    scale = a.sigma_ref / (a.noise_a + a.noise_b * dz * dz);
-  }
+  if (a.sigma_ref > 0.0f) scale = a.sigma_ref / a.noise.sigma(v.z());
   const float r_ref = r * scale;
   const float w = scale * scale * (fabsf(r_ref) <= a.huber_delta ? 1.0f : a.huber_delta / fabsf(r_ref));
   const Eigen::Vector3f pm = p.cross(m);
