@@ -81,7 +81,7 @@ struct Options {
   std::string dataset, out_dir, mode = "icp";
   rrg::io::DatasetFlags flags;
   int frames = 0, progress = 50;
-  float voxel = 0.01f, trunc = 0.0f, max_depth = 5.0f;
+  float voxel = 0.01f, trunc = 0.0f, max_depth = 5.0f, band_sigmas = rrg::TsdfParams{}.band_sigmas;
   int o3d_block_resolution = 16, o3d_block_count = 10000;
   float o3d_depth_diff = 0.07f, o3d_min_fitness = 0.1f, o3d_max_translation = 0.15f;
   std::vector<int> o3d_iterations = {6, 3, 1};  // coarse to fine, TrackFrameToModel's default
@@ -220,6 +220,8 @@ void run(const Options& o) {
   tsdf.voxel_size = o.voxel;
   tsdf.truncation = o.trunc > 0.0f ? o.trunc : 4.0f * o.voxel;  // rrg track's default
   tsdf.max_depth = o.max_depth;
+  tsdf.band_sigmas = o.band_sigmas;  // ours as rrg track runs it; Open3D keeps its constant band
+  tsdf.noise = params.icp.noise;
   rrg::TsdfVolume volume(tsdf, cpu);
   rrg::TsdfModelSource model(volume, K);
   rrg::Tracker tracker(params, K, cpu);
@@ -439,6 +441,7 @@ int main(int argc, char** argv) {
   app.add_option("dataset,--dataset", o.dataset, "dataset folder (TUM, 7-Scenes, Replica, synth)")->required();
   app.add_option("--frames", o.frames, "first N frames (0 = all)")->capture_default_str()->check(CLI::NonNegativeNumber);
   app.add_option("--voxel", o.voxel, "voxel size, metres (both)")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--band-sigmas", o.band_sigmas, "ours: k of the truncation band max(ε, k σ_n(d)), as rrg track");
   app.add_option("--trunc", o.trunc, "truncation, metres (both; default 4 x voxel, as rrg track)")
       ->check(CLI::PositiveNumber);
   app.add_option("--max-depth", o.max_depth, "depth range limit, metres (both)")->capture_default_str()

@@ -68,7 +68,7 @@ struct Times {
 int main(int argc, char** argv) {
   CLI::App app{"TSDF: ours vs Open3D VoxelBlockGrid (CPU)"};
   int width = 640, height = 480, frames = 8;
-  float voxel = 0.005f, truncation = 0.02f, max_depth = 10.0f;
+  float voxel = 0.005f, truncation = 0.02f, max_depth = 10.0f, band_sigmas = 0.0f;
   std::string preset = "living_room";
   app.add_option("--width", width);
   app.add_option("--height", height);
@@ -76,6 +76,8 @@ int main(int argc, char** argv) {
   app.add_option("--voxel", voxel, "voxel size s, metres");
   app.add_option("--trunc", truncation, "truncation ε, metres");
   app.add_option("--max-depth", max_depth, "depth range of fusion and raycast, metres");
+  app.add_option("--band-sigmas", band_sigmas,
+                 "ours: k of the band max(ε, k σ_n(d)); default 0, Open3D's constant band (like for like)");
   app.add_option("--preset", preset);
   CLI11_PARSE(app, argc, argv);
 
@@ -101,6 +103,7 @@ int main(int argc, char** argv) {
   params.voxel_size = voxel;
   params.truncation = truncation;
   params.max_depth = max_depth;
+  params.band_sigmas = band_sigmas;
   params.initial_blocks = kBlockCapacity;  // both start with the same preallocated block pool
   rrg::TsdfVolume ours(params, cpu);
   const float trunc_mult = truncation / voxel;

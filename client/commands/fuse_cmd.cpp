@@ -24,7 +24,7 @@ namespace {
 struct FuseOptions {
   std::string dataset, out, save, device = "auto";
   io::DatasetFlags flags;
-  float voxel = 0.01f, trunc = 0.0f, max_depth = 10.0f, stream_radius = 0.0f;
+  float voxel = 0.01f, trunc = 0.0f, max_depth = 10.0f, stream_radius = 0.0f, band_sigmas = TsdfParams{}.band_sigmas;
   int every = 1, max_frames = 0;
   bool raycast = false;
 };
@@ -40,7 +40,9 @@ void run_fuse(const FuseOptions& o) {
   TsdfParams params;
   params.voxel_size = o.voxel;
   params.truncation = o.trunc > 0.0f ? o.trunc : 4.0f * o.voxel;
+  params.band_sigmas = o.band_sigmas;
   params.max_depth = o.max_depth;
+  params.validate();
   TsdfVolume volume(params, device);
   const Intrinsics& K = dataset->intrinsics();
   spdlog::info("fuse: {} ({} frames, {}x{}) on {}, {}", o.dataset, dataset->size(), K.width, K.height,
@@ -113,6 +115,10 @@ void register_fuse_command(CLI::App& app) {
   cmd->add_option("--out", opts->out, "output mesh (PLY)")->required();
   cmd->add_option("--voxel", opts->voxel, "voxel size s, metres")->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--trunc", opts->trunc, "truncation ε, metres (default 4 × voxel)")->check(CLI::PositiveNumber);
+  cmd->add_option("--band-sigmas", opts->band_sigmas,
+                  "k of the truncation band max(ε, k σ_n(d)) with Kinect v1's σ_n (0: ε at every depth)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--max-depth", opts->max_depth, "ignore depth beyond this, metres")->capture_default_str();
   cmd->add_option("--device", opts->device, "cpu | cuda | cuda:N | auto")->capture_default_str();
   cmd->add_option("--every", opts->every, "fuse every N-th frame")->capture_default_str();

@@ -30,7 +30,7 @@ namespace {
 struct TrackOptions {
   std::string dataset, out, mode = "icp+orb+mask", mask = "auto", device = "auto", log, mesh;
   io::DatasetFlags flags;
-  float voxel = 0.01f, trunc = 0.0f, max_depth = 5.0f;
+  float voxel = 0.01f, trunc = 0.0f, max_depth = 5.0f, band_sigmas = TsdfParams{}.band_sigmas;
   int max_frames = 0, progress = 50;
   bool no_bilateral = false, identity_start = false, fuse_raw = false, no_noise_weighting = false;
   float icp_prior = TrackingParams{}.orb.icp_prior_scale;
@@ -65,7 +65,10 @@ void run_track(const TrackOptions& o) {
   TsdfParams tsdf;
   tsdf.voxel_size = o.voxel;
   tsdf.truncation = o.trunc > 0.0f ? o.trunc : 4.0f * o.voxel;
+  tsdf.band_sigmas = o.band_sigmas;
+  tsdf.noise = params.icp.noise;  // one sensor
   tsdf.max_depth = o.max_depth;
+  tsdf.validate();
   TsdfVolume volume(tsdf, device);
   TsdfModelSource model(volume, K);
   Tracker tracker(params, K, device);
@@ -184,6 +187,10 @@ void register_track_command(CLI::App& app) {
   cmd->add_option("--device", opts->device, "cpu | cuda | cuda:N | auto")->capture_default_str();
   cmd->add_option("--voxel", opts->voxel, "TSDF voxel size, metres")->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--trunc", opts->trunc, "truncation, metres (default 4 x voxel)")->check(CLI::PositiveNumber);
+  cmd->add_option("--band-sigmas", opts->band_sigmas,
+                  "k of the truncation band max(ε, k σ_n(d)) with Kinect v1's σ_n (0: ε at every depth)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--max-depth", opts->max_depth, "ignore depth beyond this, metres")->capture_default_str()
       ->check(CLI::PositiveNumber);
   cmd->add_option("--max-frames", opts->max_frames, "stop after N frames (0 = all)")->capture_default_str()

@@ -99,7 +99,7 @@ void MappingWorker::loop() {
 Session::Impl::Impl(SessionConfig c, std::unique_ptr<SemanticCue> cue)
     : config(validated(std::move(c))),
       K(config.K),
-      volume(config.tsdf, config.device),
+      volume(config.tsdf_params(), config.device),
       model(volume, K, volume_mutex),
       tracker(config.tracking_params(), K, config.device),
       identifier(config.planes, cue ? std::move(cue) : cue_from_config(config)),

@@ -132,6 +132,12 @@ TrackingParams SessionConfig::tracking_params() const {
   return t;
 }
 
+TsdfParams SessionConfig::tsdf_params() const {
+  TsdfParams t = tsdf;
+  t.noise = planes.segmentation.noise;
+  return t;
+}
+
 void SessionConfig::validate() const {
   if (!K.valid())
     throw std::invalid_argument("config intrinsics: need fx, fy > 0 and a positive image size (got " + K.to_string() + ")");
@@ -141,7 +147,7 @@ void SessionConfig::validate() const {
   if (!(K.cx > -K.width && K.cx < 2.0f * K.width && K.cy > -K.height && K.cy < 2.0f * K.height))
     throw std::invalid_argument("config intrinsics: principal point (" + float_text(K.cx) + ", " + float_text(K.cy) +
                                 ") is far outside the image");
-  tsdf.validate();
+  tsdf_params().validate();
   tracking_params().validate();
   planes.validate();
   mapping.validate();
@@ -183,6 +189,8 @@ std::vector<ConfigField> config_fields(SessionConfig& c) {
   // TSDF (§3.1, §4.1.4)
   t.f("tsdf.voxel_size", c.tsdf.voxel_size, "voxel size s, metres");
   t.f("tsdf.truncation", c.tsdf.truncation, "truncation ε, metres");
+  t.f("tsdf.band_sigmas", c.tsdf.band_sigmas,
+      "k of the truncation band max(ε, k σ_n(d)), σ_n from planes.segmentation.noise_*; 0: ε at every depth");
   t.i("tsdf.max_weight", c.tsdf.max_weight, "W_max");
   t.i("tsdf.reflection_window", c.tsdf.reflection_window, "W of the reflection strength average");
   t.f("tsdf.min_depth", c.tsdf.min_depth, "ignore depth below, metres");

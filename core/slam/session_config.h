@@ -41,6 +41,8 @@ struct SessionConfig {
   // `tracking` with the sensor's noise model, planes.segmentation.noise (one sensor: ICP's noise
   // weighting and plane segmentation assume the same σ_n(z)).
   TrackingParams tracking_params() const;
+  // `tsdf` with the same sensor noise model for its truncation band ε(d) = max(ε, k σ_n(d)).
+  TsdfParams tsdf_params() const;
 };
 
 // One named field of SessionConfig, typed by its text form.

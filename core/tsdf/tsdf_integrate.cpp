@@ -52,7 +52,7 @@ int64_t integrate_any(TsdfVolume& volume, const DeviceImage<float>& depth, const
   const Span<const int32_t> active = volume.allocate_from_depth(depth, K, R_wc, t_wc);
   const Eigen::Matrix3f R_cw = R_wc.transpose();
   kernel::IntegrateArgs<ColorT> a{pixels.view(), color.view(), K, R_cw, Eigen::Vector3f(-(R_cw * t_wc)),
-                                  p.voxel_size, p.truncation, p.max_weight, p.reflection_window, active,
+                                  p.voxel_size, p.band(), p.max_weight, p.reflection_window, active,
                                   volume.block_keys(), volume.geometry(), volume.attributes(),
                                   volume.block_versions(), volume.version(), refl != nullptr,
                                   refl ? 1.0f / refl->exposure_gain : 1.0f,

@@ -13,7 +13,7 @@ namespace {
 template <class ColorT>
 void integrate_rows(const IntegrateArgs<ColorT>& a) {
   const IntegrateArgs<ColorT> args = a;
-  const VoxelProjection vp = voxel_projection(a.K, a.pixels.width, a.pixels.height, a.truncation);
+  const VoxelProjection vp = voxel_projection(a.K, a.pixels.width, a.pixels.height, a.band);
   const Eigen::Vector3f step_x = a.R_cw.col(0) * a.voxel_size;
   parallel_for(CpuBackend{}, a.active.size * (kBlockVoxels / kBlockSide), [&](int64_t item) {
     const int32_t block = args.active[item / (kBlockVoxels / kBlockSide)];

@@ -5,6 +5,7 @@
 #include "core/common/hd.h"
 #include "core/common/span.h"
 #include "core/tsdf/fusion_pixel.h"
+#include "core/tsdf/truncation_band.h"
 #include "core/tsdf/voxel.h"
 
 #include <Eigen/Core>
@@ -29,11 +30,11 @@ struct VoxelProjection {
   float fx, fy, cx, cy;
   float inv_fx, inv_fy;
   float width, height;  // of the fusion-pixel image
-  float truncation, inv_truncation;
+  TruncationBand band;  // ε(d)
 };
 
-inline VoxelProjection voxel_projection(const Intrinsics& K, int width, int height, float truncation) {
-  return {K.fx, K.fy, K.cx, K.cy, 1.0f / K.fx, 1.0f / K.fy, float(width), float(height), truncation, 1.0f / truncation};
+inline VoxelProjection voxel_projection(const Intrinsics& K, int width, int height, const TruncationBand& band) {
+  return {K.fx, K.fy, K.cx, K.cy, 1.0f / K.fx, 1.0f / K.fy, float(width), float(height), band};
 }
 
 // The nearest pixel (u, v) of a voxel at camera-frame position p_c; false when it is behind the
@@ -56,7 +57,7 @@ RRG_HD RRG_INLINE bool voxel_pixel(const VoxelProjection& vp, const Eigen::Vecto
 // the band, where identification frames also update the reflection attributes. Straight-line.
 struct VoxelFusion {
   enum Kind : int32_t { kNone = 0, kFreeSpace = 1, kBand = 2 };
-  float t;      // min(1, sdf / ε), the observation fused
+  float t;      // min(1, sdf / ε(d)), the observation fused
   int32_t kind;
 };
 
@@ -65,18 +66,19 @@ RRG_HD RRG_INLINE VoxelFusion voxel_fusion(const VoxelProjection& vp, const Fusi
   const Eigen::Vector3f P((float(u) - vp.cx) * vp.inv_fx * px.d, (float(v) - vp.cy) * vp.inv_fy * px.d, px.d);
   const Eigen::Vector3f dp = p_c - P;
   const float sdf = px.nx * dp.x() + px.ny * dp.y() + px.nz * dp.z();
-  const bool skipped = !(px.d > 0.0f) | (sdf < -vp.truncation);  // no pixel data; behind the band
-  const bool in_band = sdf < vp.truncation;
-  const bool near_point = !(dp.squaredNorm() > vp.truncation * vp.truncation);
-  const float ratio = sdf * vp.inv_truncation;  // (read unconditionally: a read under the select keeps the loop scalar)
+  const float eps = vp.band.at(px.d);  // ε(d) of this pixel's observation
+  const bool skipped = !(px.d > 0.0f) | (sdf < -eps);  // no pixel data; behind the band
+  const bool in_band = sdf < eps;
+  const bool near_point = !(dp.squaredNorm() > eps * eps);
+  const float ratio = sdf / eps;  // (computed unconditionally: a division under the select keeps the loop scalar)
   VoxelFusion f;
-  f.t = sdf >= vp.truncation ? 1.0f : ratio;
+  f.t = sdf >= eps ? 1.0f : ratio;
   f.kind = skipped ? VoxelFusion::kNone
                    : (!in_band ? VoxelFusion::kFreeSpace : (near_point ? VoxelFusion::kBand : VoxelFusion::kNone));
   return f;
 }
 
-// Standard fusion with one observation of normalised distance t_obs = min(1, sdf / ε):
+// Standard fusion with one observation of normalised distance t_obs = min(1, sdf / ε(d)):
 //   d ← (W d + t_obs) / (W + 1),  c̄_{n+1} = (n c̄_n + c_t) / (n + 1) with n = W,  W ← min(W + 1, W_max)
 RRG_HD inline void fuse_sdf_color(TsdfVoxel& g, AttrVoxel& a, float t_obs, const Eigen::Vector3f& c,
                                   int max_weight) {
@@ -87,7 +89,7 @@ RRG_HD inline void fuse_sdf_color(TsdfVoxel& g, AttrVoxel& a, float t_obs, const
   g.weight = uint16_t(g.weight + 1 > max_weight ? max_weight : g.weight + 1);
 }
 
-// Reflection attributes, only on identification frames and only inside the band |sdf| < ε:
+// Reflection attributes, only on identification frames and only inside the band |sdf| < ε(d):
 //   x_t = (r + g + b) / 3;  δ = x_t − μ_n;  μ_{n+1} = μ_n + δ / (n + 1);  M_{2,n+1} = M_{2,n} + δ (x_t − μ_{n+1})
 //   r ← r + (m_t − r) / min(n + 1, W)   (mean of the masks so far, then an average over ~W windows)
 //   π ← canonical(id) when the pixel has a plane, else unchanged

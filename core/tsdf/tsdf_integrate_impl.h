@@ -43,7 +43,8 @@ struct IntegrateArgs {
   Intrinsics K;
   Eigen::Matrix3f R_cw;                    // world -> camera
   Eigen::Vector3f t_cw;
-  float voxel_size, truncation;
+  float voxel_size;
+  TruncationBand band;                     // ε(d)
   int max_weight, window;
   Span<const int32_t> active;              // blocks touched by this frame
   Span<const uint64_t> block_keys;
@@ -93,7 +94,7 @@ RRG_HD RRG_INLINE void fuse_voxel(const IntegrateArgs<ColorT>& args, int64_t k, 
 template <class Backend, class ColorT>
 void integrate(Backend backend, const IntegrateArgs<ColorT>& a) {
   const IntegrateArgs<ColorT> args = a;
-  const VoxelProjection vp = voxel_projection(a.K, a.pixels.width, a.pixels.height, a.truncation);
+  const VoxelProjection vp = voxel_projection(a.K, a.pixels.width, a.pixels.height, a.band);
   const Eigen::Vector3f step_x = a.R_cw.col(0) * a.voxel_size;  // camera-frame step of one voxel in x
   parallel_for(backend, a.active.size * (kBlockVoxels / kBlockSide), [=] RRG_HD(int64_t item) {
     const int32_t block = args.active[item / (kBlockVoxels / kBlockSide)];

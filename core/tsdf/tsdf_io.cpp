@@ -14,8 +14,10 @@ namespace {
 
 static_assert(std::endian::native == std::endian::little, "the TSDF file format is little-endian");
 
-// magic 8, version 4, voxel bytes 4, 4 floats, 2 int32, volume version 8, blocks 8, payload bytes 8, checksum 8
-constexpr size_t kHeaderBytes = 8 + 4 + 4 + 16 + 8 + 8 + 8 + 8 + 8;
+// magic 8, version 4, voxel bytes 4, 4 floats, 2 int32, [version 2: the band's 4 floats,] volume
+// version 8, blocks 8, payload bytes 8, checksum 8
+constexpr size_t kHeaderBytesV1 = 8 + 4 + 4 + 16 + 8 + 8 + 8 + 8 + 8;
+constexpr size_t kHeaderBytes = kHeaderBytesV1 + 16;
 constexpr size_t kBlockBytes = 3 * 4 + 8 + kBlockVoxels * sizeof(Voxel);
 
 template <class T>
@@ -71,6 +73,10 @@ void save_volume(const TsdfVolume& volume, const std::filesystem::path& path) {
   put(header, prm.max_depth);
   put(header, int32_t(prm.max_weight));
   put(header, int32_t(prm.reflection_window));
+  put(header, prm.band_sigmas);
+  put(header, prm.noise.a);
+  put(header, prm.noise.b);
+  put(header, prm.noise.z0);
   put(header, volume.version());
   put(header, uint64_t(blocks.size()));
   put(header, uint64_t(payload.size()));
@@ -90,12 +96,14 @@ TsdfVolume load_volume(const std::filesystem::path& path, const Device& device) 
   const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
   if (bytes.size() < sizeof(kTsdfMagic) || std::memcmp(bytes.data(), kTsdfMagic, sizeof(kTsdfMagic)) != 0)
     fail(path, "not an RRG TSDF volume (bad magic)");
-  if (bytes.size() < kHeaderBytes) fail(path, "truncated header (" + std::to_string(bytes.size()) + " bytes)");
+  if (bytes.size() < kHeaderBytesV1) fail(path, "truncated header (" + std::to_string(bytes.size()) + " bytes)");
   Reader r{bytes, sizeof(kTsdfMagic)};
   const auto version = r.get<uint32_t>();
-  if (version != kTsdfFormatVersion)
-    fail(path, "unsupported format version " + std::to_string(version) + " (this build reads " +
+  if (version != 1 && version != kTsdfFormatVersion)
+    fail(path, "unsupported format version " + std::to_string(version) + " (this build reads 1 to " +
                    std::to_string(kTsdfFormatVersion) + ")");
+  const size_t header_bytes = version == 1 ? kHeaderBytesV1 : kHeaderBytes;
+  if (bytes.size() < header_bytes) fail(path, "truncated header (" + std::to_string(bytes.size()) + " bytes)");
   const auto voxel_bytes = r.get<uint32_t>();
   if (voxel_bytes != sizeof(Voxel)) fail(path, "voxel layout of " + std::to_string(voxel_bytes) + " bytes, expected 24");
   TsdfParams prm;
@@ -105,15 +113,23 @@ TsdfVolume load_volume(const std::filesystem::path& path, const Device& device) 
   prm.max_depth = r.get<float>();
   prm.max_weight = r.get<int32_t>();
   prm.reflection_window = r.get<int32_t>();
+  if (version == 1) {
+    prm.band_sigmas = 0.0f;  // fused with the constant band: fusion goes on as it was
+  } else {
+    prm.band_sigmas = r.get<float>();
+    prm.noise.a = r.get<float>();
+    prm.noise.b = r.get<float>();
+    prm.noise.z0 = r.get<float>();
+  }
   const auto volume_version = r.get<uint64_t>();
   const auto n_blocks = r.get<uint64_t>();
   const auto payload_bytes = r.get<uint64_t>();
   const auto checksum = r.get<uint64_t>();
   if (payload_bytes != n_blocks * kBlockBytes) fail(path, "inconsistent header (payload size vs block count)");
-  if (bytes.size() - kHeaderBytes != payload_bytes)
-    fail(path, "truncated or oversized: payload of " + std::to_string(bytes.size() - kHeaderBytes) +
+  if (bytes.size() - header_bytes != payload_bytes)
+    fail(path, "truncated or oversized: payload of " + std::to_string(bytes.size() - header_bytes) +
                    " bytes, header says " + std::to_string(payload_bytes));
-  if (fnv1a64(std::span(bytes).subspan(kHeaderBytes)) != checksum) fail(path, "checksum mismatch (corrupted file)");
+  if (fnv1a64(std::span(bytes).subspan(header_bytes)) != checksum) fail(path, "checksum mismatch (corrupted file)");
   try {
     prm.validate();
   } catch (const std::invalid_argument& e) {

@@ -11,7 +11,7 @@
 namespace rrg {
 
 inline constexpr char kTsdfMagic[8] = {'R', 'R', 'G', 'T', 'S', 'D', 'F', '\0'};
-inline constexpr uint32_t kTsdfFormatVersion = 1;
+inline constexpr uint32_t kTsdfFormatVersion = 2;  // 2: the truncation band (k, σ_n); 1 still loads, with k = 0
 
 // Written atomically (core/io/atomic_file.h): a failure leaves no file behind.
 void save_volume(const TsdfVolume& volume, const std::filesystem::path& path);

@@ -44,6 +44,9 @@ RRG_HD inline float block_exit(const Eigen::Vector3f& p, const Eigen::Vector3f& 
 //                                                along the fusing rays, so a step may overshoot it only
 //                                                into the band behind it (f ≥ −1), where the crossing
 //                                                is still bracketed (as Open3D's march steps);
+//                                                where fusion's band ε(d) was wider than ε
+//                                                (truncation_band.h) f · ε is less than that
+//                                                distance: a shorter step, never a longer one;
 //   f ≤ 0 without a positive sample before    → one voxel (entering from behind a surface).
 // One ray's march as a state machine: march_begin() sets it up, each march_step() takes one
 // sample (a crossing's refinement included) and returns true when the ray is done (s.hit says how).
@@ -111,7 +114,9 @@ RRG_TU_LOCAL RRG_HD inline bool march_step(const VolumeView& vol, MarchState& m,
     for (int it = 0; it < kRefineSteps && (zb - za) * m.len > kRefineTol * s; ++it) {
       float fc;
       if (!sample_tsdf(vol, m.o + zc * d, cache, fc)) break;
-      if (fabsf(fc) * m.truncation <= kRefineTol * s) break;  // |d| bounds the distance to the surface
+      // |d| = |f| ε(d) is the distance to the surface; |f| ε may be less by ε(d) / ε (about 4 at
+      // 4 m), which at 10⁻³ voxel is still far below the depth noise.
+      if (fabsf(fc) * m.truncation <= kRefineTol * s) break;
       if (fc > 0.0f) {
         za = zc;
         fa = fc;

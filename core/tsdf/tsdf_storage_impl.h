@@ -3,6 +3,7 @@
 // blocks, rehash, block gather / scatter. Bodies templated on the back-end tag; instantiated by
 // tsdf_storage_cpu.cpp and tsdf_storage_cuda.cu.
 #include "core/common/camera.h"
+#include "core/tsdf/truncation_band.h"
 #include "core/tsdf/voxel_hash_device.h"
 
 #include <Eigen/Core>
@@ -16,7 +17,9 @@ struct TouchArgs {
   Intrinsics K;
   Eigen::Matrix3f R_wc;
   Eigen::Vector3f t_wc;
-  float voxel_size, truncation, min_depth, max_depth;
+  float voxel_size;
+  TruncationBand band;       // ε(d)
+  float min_depth, max_depth;
   HashView hash;
   Span<int32_t> stamps;      // [blocks] last pass that listed the block active
   int32_t pass_id;
@@ -61,7 +64,7 @@ RRG_HD void for_blocks_on_segment(const Eigen::Vector3f& a, const Eigen::Vector3
 inline constexpr int kTouchRun = 8;    // pixels of a row per work item of touch_blocks
 inline constexpr int kTouchCache = 8;  // recent block keys a work item remembers
 
-// Per valid depth pixel: every block on its ray within [d - ε, d + ε] is found or inserted. A work
+// Per valid depth pixel: every block on its ray within [d - ε(d), d + ε(d)] is found or inserted. A work
 // item takes a run of kTouchRun pixels of one row: neighbouring pixels cross mostly the same blocks
 // (a 4 cm block spans ~10 pixels at 2 m), so a key met again within the run is skipped instead of
 // probing the hash table and its atomics again.
@@ -81,7 +84,8 @@ void touch_blocks(Backend backend, const TouchArgs& a) {
     for (int x = x0; x < x1; ++x) {
       const float d = args.depth(x, y);
       if (!(d >= args.min_depth && d <= args.max_depth)) continue;
-      const float d0 = max_f(d - args.truncation, 1e-3f), d1 = d + args.truncation;
+      const float eps = args.band.at(d);
+      const float d0 = max_f(d - eps, 1e-3f), d1 = d + eps;
       const Eigen::Vector3f p0 = args.R_wc * args.K.unproject(float(x), float(y), d0) + args.t_wc;
       const Eigen::Vector3f p1 = args.R_wc * args.K.unproject(float(x), float(y), d1) + args.t_wc;
       const Eigen::Vector3f q0 = p0 * to_block + Eigen::Vector3f::Constant(half);

@@ -178,7 +178,7 @@ Span<const int32_t> TsdfVolume::allocate_from_depth(const DeviceImage<float>& de
   for (;;) {
     ++pass_id_;
     counters_.fill_zero();
-    kernel::TouchArgs a{depth.view(), K, R_wc, t_wc, params_.voxel_size, params_.truncation,
+    kernel::TouchArgs a{depth.view(), K, R_wc, t_wc, params_.voxel_size, params_.band(),
                         params_.min_depth, params_.max_depth, hash_view(),
                         {block_stamps_.data(), num_blocks_}, pass_id_, new_keys_.span(), new_slots_.span(),
                         {active_.data(), num_blocks_}, counters_.data()};

@@ -102,7 +102,15 @@ TEST(SessionConfig, OverridesSetFieldsAndRejectNonsense) {
   EXPECT_FLOAT_EQ(t.icp.noise.a, c.planes.segmentation.noise.a);
   EXPECT_FLOAT_EQ(t.icp.noise_reference_depth_m, 2.0f);
   EXPECT_FLOAT_EQ(t.icp.huber_delta_m, 0.02f);
+  // The TSDF's truncation band uses the same sensor model.
+  EXPECT_FLOAT_EQ(c.tsdf_params().band_sigmas, 3.0f);
+  EXPECT_FLOAT_EQ(c.tsdf_params().noise.b, 0.003f);
+  apply_override(c, "tsdf.band_sigmas=2");
+  EXPECT_FLOAT_EQ(c.tsdf_params().band_sigmas, 2.0f);
   c.validate();
+  apply_override(c, "tsdf.band_sigmas=-1");
+  expect_rejected_naming(c, "band_sigmas", "band_sigmas");
+  apply_override(c, "tsdf.band_sigmas=3");
   apply_override(c, "tracking.icp.noise_reference_depth_m=0");
   expect_rejected_naming(c, "noise_reference_depth_m", "noise_reference_depth_m 0");
   apply_override(c, "tracking.icp.noise_weighting=false");

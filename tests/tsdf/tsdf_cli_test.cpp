@@ -25,6 +25,7 @@ TEST(TsdfCli, FusesASyntheticSequenceIntoAnAccurateMesh) {
   EXPECT_NE(fuse.output.find("fused 20 frames"), std::string::npos) << fuse.output;
   EXPECT_NE(fuse.output.find("fusion"), std::string::npos) << fuse.output;  // timing summary
   EXPECT_EQ(load_volume(vol, Device::cpu()).version(), 20u);
+  EXPECT_EQ(load_volume(vol, Device::cpu()).params().band_sigmas, 3.0f);  // the noise band by default
 
   // Accuracy is measured to samples of the whole-room ground-truth mesh (~120 m^2), so the sample
   // spacing sqrt(A/N) sets a floor: 1M samples give ~1 cm spacing, a mean floor of ~0.5 cm, far
@@ -73,6 +74,11 @@ TEST(TsdfCli, ErrorsExitWithAMessage) {
                                        " --out " + (tmp / "m.ply").string() + " --every 0");
   EXPECT_EQ(bad_every.exit_code, 1) << bad_every.output;
   EXPECT_NE(bad_every.output.find("--every"), std::string::npos) << bad_every.output;
+  const auto bad_band = test::run_rrg("fuse " + (test::test_data_dir() / "7scenes_mini").string() +
+                                      " --out " + (tmp / "m.ply").string() + " --band-sigmas -1");
+  EXPECT_NE(bad_band.exit_code, 0) << bad_band.output;
+  EXPECT_NE(bad_band.output.find("--band-sigmas"), std::string::npos) << bad_band.output;
+  EXPECT_FALSE(std::filesystem::exists(tmp / "m.ply"));
 }
 
 TEST(TsdfCli, FusesRealFramesOf7Scenes) {

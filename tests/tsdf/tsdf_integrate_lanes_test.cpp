@@ -92,7 +92,7 @@ TEST(TsdfIntegrate, RowLanesMatchThePerVoxelLoop) {
     const auto args = [&](Blocks& b) {
       return kernel::IntegrateArgs<Eigen::Vector3f>{
           pixels.view(), ImageView<const Eigen::Vector3f>{color.data(), K.width, K.height}, K, R_cw, t_cw,
-          0.01f, 0.04f, 100, 5,
+          0.01f, TruncationBand{0.015f, 3.0f, DepthNoiseModel{}}, 100, 5,  // ε(d) > ε beyond 1.8 m: the plane
           Span<const int32_t>{b.active.data(), int64_t(b.active.size())},
           Span<const uint64_t>{b.keys.data(), int64_t(b.keys.size())},
           Span<TsdfVoxel>{b.geometry.data(), int64_t(b.geometry.size())},

@@ -21,6 +21,8 @@ TsdfVolume fused(const Device& device) {
   p.voxel_size = 0.01f;
   p.truncation = 0.04f;
   p.reflection_window = 3;
+  p.band_sigmas = 2.5f;  // not the defaults: the file must carry them
+  p.noise.a = 0.002f;
   TsdfVolume v(p, device);
   const test::Scene scene = test::sphere_scene({0, 0, 0}, 0.25f);
   const auto poses = test::cameras_around({0, 0, 0}, 0.9f);
@@ -64,6 +66,10 @@ TEST(TsdfIo, SaveLoadRoundTripIsIdenticalOnEveryDevice) {
       EXPECT_EQ(b.version(), a.version());
       EXPECT_EQ(b.num_blocks(), a.num_blocks());
       EXPECT_EQ(b.params().reflection_window, 3);
+      EXPECT_EQ(b.params().band_sigmas, 2.5f);
+      EXPECT_EQ(b.params().noise.a, 0.002f);
+      EXPECT_EQ(b.params().noise.b, DepthNoiseModel{}.b);
+      EXPECT_EQ(b.params().noise.z0, DepthNoiseModel{}.z0);
       EXPECT_EQ(test::flatten_voxels(b), test::flatten_voxels(a));
       if (target == device) {
         const RaycastResult ra = raycast(a, kK, novel), rb = raycast(b, kK, novel);
@@ -122,6 +128,29 @@ TEST(TsdfIo, DamagedFilesAreRejectedNamingTheFile) {
   expect_load_error(tmp / "version.tsdf", "unsupported format version 7");
 
   expect_load_error(tmp / "missing.tsdf", "cannot open");
+}
+
+// A version 1 file (before the truncation band) is the version 2 file without the band's 16 bytes
+// after the reflection window (offset 40): it loads with the same voxels and the constant band it
+// was fused with, so fusion goes on as before.
+TEST(TsdfIo, VersionOneFilesLoadWithTheConstantBand) {
+  const test::TempDir tmp("tsdf-io");
+  const TsdfVolume a = fused(Device::cpu());
+  save_volume(a, tmp / "v2.tsdf");
+  const std::vector<uint8_t> v2 = read_bytes(tmp / "v2.tsdf");
+  ASSERT_EQ(v2[8], kTsdfFormatVersion);
+  std::vector<uint8_t> v1(v2.begin(), v2.begin() + 40);
+  v1.insert(v1.end(), v2.begin() + 56, v2.end());
+  v1[8] = 1;
+  write_bytes(tmp / "v1.tsdf", v1);
+  const TsdfVolume b = load_volume(tmp / "v1.tsdf", Device::cpu());
+  EXPECT_EQ(b.params().band_sigmas, 0.0f);
+  EXPECT_EQ(b.params().reflection_window, 3);
+  EXPECT_EQ(b.version(), a.version());
+  EXPECT_EQ(test::flatten_voxels(b), test::flatten_voxels(a));
+  // a version 2 file cut after a version 1 header's length (72 bytes) but inside its own (88)
+  write_bytes(tmp / "v2-short.tsdf", std::vector<uint8_t>(v2.begin(), v2.begin() + 80));
+  expect_load_error(tmp / "v2-short.tsdf", "truncated header");
 }
 
 TEST(TsdfIo, FailedSaveLeavesNothingBehind) {
