@@ -257,7 +257,12 @@ std::set<int> undecided_candidates(const std::set<int>& previous, const Identifi
                                    bool every_plane_is_candidate) {
   std::set<int> open;
   if (every_plane_is_candidate) return open;
-  const auto undecided = [&](int id) { return !vote.accepted(id) && vote.history_size(id) < vote.params().windows; };
+  const ReflectiveVoteParams& vp = vote.params();
+  const auto undecided = [&](int id) {
+    const int seen_windows = vote.history_size(id);
+    return !vote.accepted(id) && seen_windows < vp.windows &&
+           vote.reflective_count(id) + (vp.windows - seen_windows) >= vp.min_reflective;
+  };
   std::set<int> seen;
   for (const PlaneVerdict& v : window.planes) {
     seen.insert(v.global_id);

@@ -90,12 +90,21 @@ TEST(ReflectiveVote, UndecidedCandidatesAreTheSemanticCandidatesWithAnOpenVote) 
   }
   EXPECT_TRUE(vote.accepted(1));
 
-  // A candidate that is never reflective closes once its history is full (five windows).
+  // A candidate that is never reflective closes as soon as four of its first five windows can no
+  // longer be reflective: after two.
   for (int64_t k = 8; k <= 12; ++k) {
     w.planes = {verdict(3, true)};
     vote.record(3, k, false);
     open = undecided_candidates(open, w, vote, table, false);
-    EXPECT_EQ(open.count(3), k < 12 ? 1u : 0u) << "window " << k;
+    EXPECT_EQ(open.count(3), k < 9 ? 1u : 0u) << "window " << k;
+  }
+  // Reflective, then not, then not: 1 + 3 windows to come can still make four, 1 + 2 cannot.
+  const bool outcomes[] = {true, false, false};
+  for (int64_t k = 20; k < 23; ++k) {
+    w.planes = {verdict(5, true)};
+    vote.record(5, k, outcomes[k - 20]);
+    open = undecided_candidates(open, w, vote, table, false);
+    EXPECT_EQ(open.count(5), k < 22 ? 1u : 0u) << "window " << k;
   }
   // A plane seen as no candidate in a window is decided by that window.
   w.planes = {verdict(4, true)};
