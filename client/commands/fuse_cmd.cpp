@@ -42,7 +42,6 @@ void run_fuse(const FuseOptions& o) {
   params.truncation = o.trunc > 0.0f ? o.trunc : 4.0f * o.voxel;
   params.band_sigmas = o.band_sigmas;
   params.max_depth = o.max_depth;
-  params.validate();
   TsdfVolume volume(params, device);
   const Intrinsics& K = dataset->intrinsics();
   spdlog::info("fuse: {} ({} frames, {}x{}) on {}, {}", o.dataset, dataset->size(), K.width, K.height,

@@ -68,7 +68,6 @@ void run_track(const TrackOptions& o) {
   tsdf.band_sigmas = o.band_sigmas;
   tsdf.noise = params.icp.noise;  // one sensor
   tsdf.max_depth = o.max_depth;
-  tsdf.validate();
   TsdfVolume volume(tsdf, device);
   TsdfModelSource model(volume, K);
   Tracker tracker(params, K, device);

@@ -109,9 +109,10 @@ struct IdentificationResult {
 // The planes whose reflection is open after a window: semantic candidates (a reflective
 // category's mask is theirs) that are not in L_ref, have fewer than `vote.params().windows` windows
 // of history, and can still be accepted within them (reflective so far + windows to come >=
-// min_reflective: with the paper's 4 of 5, two non-reflective windows decide). The planes `window` saw are decided by its verdicts; the others of `previous`
-// (the last window's set) stay while their vote stays open, under their canonical ids (`table`:
-// merges). Empty when every plane is a candidate (the `none` cue: candidacy carries no evidence).
+// min_reflective: with the paper's 4 of 5, two non-reflective windows decide). The planes `window`
+// saw are decided by its verdicts; the others of `previous` (the last window's set) stay while
+// their vote stays open, under their canonical ids (`table`: merges). Empty when every plane is a
+// candidate (the `none` cue: candidacy carries no evidence).
 // The session keeps these planes out of the tracking mask's features until the vote decides
 // (docs/tracking.md "Reflections not modelled yet").
 std::set<int> undecided_candidates(const std::set<int>& previous, const IdentificationResult& window,

@@ -64,10 +64,10 @@ RRG_HD void for_blocks_on_segment(const Eigen::Vector3f& a, const Eigen::Vector3
 inline constexpr int kTouchRun = 8;    // pixels of a row per work item of touch_blocks
 inline constexpr int kTouchCache = 8;  // recent block keys a work item remembers
 
-// Per valid depth pixel: every block on its ray within [d - ε(d), d + ε(d)] is found or inserted. A work
-// item takes a run of kTouchRun pixels of one row: neighbouring pixels cross mostly the same blocks
-// (a 4 cm block spans ~10 pixels at 2 m), so a key met again within the run is skipped instead of
-// probing the hash table and its atomics again.
+// Per valid depth pixel: every block on its ray within [d - ε(d), d + ε(d)] is found or inserted
+// (truncation_band.h). A work item takes a run of kTouchRun pixels of one row: neighbouring pixels
+// cross mostly the same blocks (a 4 cm block spans ~10 pixels at 2 m), so a key met again within
+// the run is skipped instead of probing the hash table and its atomics again.
 template <class Backend>
 void touch_blocks(Backend backend, const TouchArgs& a) {
   const TouchArgs args = a;
