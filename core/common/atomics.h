@@ -73,4 +73,17 @@ RRG_HD inline int32_t atomic_max(int32_t* address, int32_t value) {
 #endif
 }
 
+// Unsigned 64-bit minimum; returns the old value. On the CPU a CAS loop.
+RRG_HD inline uint64_t atomic_min(uint64_t* address, uint64_t value) {
+#if defined(__CUDA_ARCH__)
+  return atomicMin(reinterpret_cast<unsigned long long*>(address), (unsigned long long)value);
+#else
+  uint64_t old = __atomic_load_n(address, __ATOMIC_RELAXED);
+  while (value < old &&
+         !__atomic_compare_exchange_n(address, &old, value, true, __ATOMIC_ACQ_REL, __ATOMIC_RELAXED)) {
+  }
+  return old;
+#endif
+}
+
 }  // namespace rrg

@@ -5,6 +5,7 @@
 #include "core/planes/exposure_gain.h"
 #include "core/planes/remote_segmenter.h"
 #include "core/planes/semantic_labels.h"
+#include "core/tsdf/raycast_warp.h"
 #include "core/tsdf/tsdf_integrate.h"
 
 #include <spdlog/spdlog.h>
@@ -156,12 +157,21 @@ ReflectionView Session::Impl::render_reflection(const Eigen::Isometry3f& T_wc, f
   // At 1/f of the frame's size (tracking.orb.mask_downsample), then each pixel to its f x f block.
   const int f = config.tracking.orb.mask_downsample;
   const Intrinsics Ks = f == 1 ? K : K.scaled(std::max(1, K.width / f), std::max(1, K.height / f));
-  const RaycastResult rc = locked_raycast(Ks, T_wc, RaycastOutputs{.color = false, .reflection = true, .normals = false});
-  const ColorImage C_r = gaussians ? mapper.render_reflection(RenderCamera{Ks, T_wc}, rc.plane_ids, stop_mean)
+  // I at T_wc: the ICP model's raycast at T_{k−1} warped there (tracking.orb.mask_warp; the model
+  // keeps I while the mask can show something), else a raycast there (the first frame, or a model
+  // raycast without I).
+  const RaycastResult* source = config.tracking.orb.mask_warp ? model.last() : nullptr;
+  if (source && source->plane_ids.width() > 0) {
+    warp_plane_ids(*source, Ks, T_wc, mask_plane_ids, mask_zbuffer);
+  } else {
+    RaycastResult rc = locked_raycast(Ks, T_wc, RaycastOutputs{.color = false, .reflection = true, .normals = false});
+    mask_plane_ids = std::move(rc.plane_ids);
+  }
+  const ColorImage C_r = gaussians ? mapper.render_reflection(RenderCamera{Ks, T_wc}, mask_plane_ids, stop_mean)
                                    : ColorImage(Ks.width, Ks.height, Color::Zero());
   MaskImage unmodelled;
   if (!unknown.empty()) {
-    const Image<int32_t> I = rc.plane_ids.to_host();
+    const Image<int32_t> I = mask_plane_ids.to_host();
     unmodelled = MaskImage(Ks.width, Ks.height, 0);
     for (size_t i = 0; i < I.size(); ++i)
       unmodelled[i] = I[i] > 0 && std::binary_search(unknown.begin(), unknown.end(), I[i]) ? 1 : 0;
@@ -384,6 +394,17 @@ FrameReport Session::process(const SessionFrame& frame) {
     else if (frame.pose) s.tracker.set_pose_prior(*frame.pose);
     if (s.frames > 0) {
       const auto tr = Clock::now();
+      // The model keeps I for the tracking mask's warp while the mask can show something (else
+      // render_reflection returns before it needs I; should that change before the mask is
+      // asked for, it raycasts).
+      bool warp = s.masks && s.config.tracking.orb.mask_warp;
+      if (warp) {
+        const auto snap = s.mapper.snapshot();
+        warp = (snap && snap->reflection.size() > 0) ||
+               !s.unmodelled_planes(snap ? std::span<const int32_t>(snap->reflection_planes) : std::span<const int32_t>{})
+                    .empty();
+      }
+      s.model.set_plane_ids(warp, warp ? std::span<const int32_t>(s.remap) : std::span<const int32_t>{});
       s.model.model_at(s.T_last);
       report.times.raycast = ms_since(tr);
     }
@@ -394,6 +415,7 @@ FrameReport Session::process(const SessionFrame& frame) {
     report.times.preprocess = r.ms_preprocess;
     report.times.icp = r.ms_icp;
     report.times.orb = r.ms_orb;
+    report.times.mask = r.ms_mask;
     report.tracking_mask_pixels = r.mask_pixels;
     keyframe = r.keyframe || r.first;
   }

@@ -49,7 +49,8 @@ struct StageTimes {
   double raycast = 0;      // model raycast at T_{k-1} for ICP
   double preprocess = 0;
   double icp = 0;
-  double orb = 0;          // ORB + motion-only BA (+ the tracking-mask render)
+  double orb = 0;          // ORB + motion-only BA (+ the tracking mask)
+  double mask = 0;         // of orb: the tracking mask R_k^track (its plane-id map and pass 3)
   double fuse = 0;
   double identify = 0;     // plane identification incl. its C_var raycast, the cue's masks and the
                            // reflective depth fill (planes.fill; on frames that do not identify too)

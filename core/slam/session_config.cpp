@@ -218,6 +218,8 @@ std::vector<ConfigField> config_fields(SessionConfig& c) {
   t.f("tracking.orb.mask_threshold", c.tracking.orb.mask_threshold, "R^track = mean RGB of C_r > this");
   t.i("tracking.orb.mask_downsample", c.tracking.orb.mask_downsample,
       "render the tracking mask at 1/f of the frame's width and height (1 = full)");
+  t.b("tracking.orb.mask_warp", c.tracking.orb.mask_warp,
+      "the tracking mask's plane ids warped from the ICP model's raycast (false: a raycast at the ICP pose)");
   t.b("tracking.orb.mask_unmodelled", c.tracking.orb.mask_unmodelled,
       "also mask the planes whose reflection is not modelled yet (open semantic candidates, accepted planes without G_r)");
   t.f("tracking.keyframes.delta_angle_deg", c.tracking.keyframes.delta_angle_deg, "keyframe rotation, degrees");

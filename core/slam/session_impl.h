@@ -37,6 +37,9 @@ class LockedModelSource final : public ModelSource {
     return inner_.model_at(T_wc);
   }
   void invalidate() { inner_.invalidate(); }
+  // The process thread's alone, as the cached maps (TsdfModelSource).
+  void set_plane_ids(bool on, std::span<const int32_t> remap = {}) { inner_.set_plane_ids(on, remap); }
+  const RaycastResult* last() const { return inner_.last(); }
 
  private:
   TsdfModelSource inner_;
@@ -95,6 +98,8 @@ struct Session::Impl {
   PlaneIdentifier identifier;
   GaussianMapper mapper;
   std::unique_ptr<MaskSource> masks;  // icp+orb+mask: rendered C_r
+  DeviceImage<int32_t> mask_plane_ids;  // I at the ICP pose for the mask (render_reflection)
+  Buffer<uint64_t> mask_zbuffer;        // its warp's scratch
   MappingWorker worker;
 
   // the schedule

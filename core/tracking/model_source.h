@@ -6,6 +6,9 @@
 #include "core/tsdf/tsdf_raycast.h"
 #include "core/tsdf/tsdf_volume.h"
 
+#include <span>
+#include <vector>
+
 namespace rrg {
 
 class ModelSource {
@@ -24,11 +27,19 @@ class TsdfModelSource final : public ModelSource {
   IcpModel model_at(const Eigen::Isometry3f& T_wc) override;
   // Forgets the cached raycast (call after fusing a frame).
   void invalidate() { valid_ = false; }
+  // With plane ids the raycast also keeps I (RaycastOutputs::reflection), canonical through
+  // `remap`, so that the tracking mask can warp it to the ICP pose (raycast_warp.h) instead of
+  // raycasting again. A change forgets the cached raycast.
+  void set_plane_ids(bool on, std::span<const int32_t> remap = {});
+  // The cached raycast (D_t, V*, N*, and I with plane ids), or null when there is none.
+  const RaycastResult* last() const { return valid_ ? &cached_ : nullptr; }
 
  private:
   const TsdfVolume& volume_;
   Intrinsics K_;
   RaycastResult cached_;
+  bool plane_ids_ = false;
+  std::vector<int32_t> remap_;
   bool valid_ = false;
   Eigen::Isometry3f cached_T_ = Eigen::Isometry3f::Identity();
 };

@@ -98,6 +98,7 @@ TrackResult Tracker::track(const TrackInput& in, ModelSource& model, MaskSource*
       std::optional<MaskImage> mask;
       if (use_mask) {
         mask = masks->mask(in.index, T_wc);
+        r.ms_mask += ms_since(t0);
         r.mask_pixels = std::count_if(mask->pixels().begin(), mask->pixels().end(), [](uint8_t m) { return m != 0; });
       }
       orb = extract_orb(*in.color, *in.depth, K_, mask ? &*mask : nullptr, params_.orb);

@@ -46,6 +46,7 @@ struct TrackResult {
   bool keyframe = false;        // a keyframe was inserted
   std::string note;             // why stage 2 was skipped / rejected, relocalisation, ...
   double ms_preprocess = 0, ms_icp = 0, ms_orb = 0;
+  double ms_mask = 0;  // of ms_orb: the tracking mask (icp+orb+mask)
 };
 
 // Everything track() carries from one frame to the next (session snapshots: a restored tracker

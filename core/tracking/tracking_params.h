@@ -69,6 +69,11 @@ struct OrbParams {
   // its pixels then covering f × f frame pixels, at 1/f² of the raycast and render; ORB dilates the
   // mask by 7 px (orb_features.cpp). 1 (default) = full resolution, as the paper (docs/tracking.md).
   int mask_downsample = 1;
+  // A session takes the mask's plane-id map I from the ICP model's raycast at T_{k−1}, warped to
+  // the ICP pose (core/tsdf/raycast_warp.h), instead of raycasting the TSDF again there: one
+  // frame's motion moves a plane's edge by about a pixel against ORB's 7 px dilation of the mask
+  // (docs/tracking.md). false: the raycast at the ICP pose.
+  bool mask_warp = true;
   float icp_prior_scale = 1e-3f;  // s of the ICP prior Λ = s JᵀJ_icp / σ_icp² in the BA (0 = none);
                                   // s < 1 because neighbouring ICP residuals are correlated
   // Consistency gate: the BA correction Δ = log(T_ba T_icp⁻¹) must satisfy Δᵀ Λ Δ <= χ²₆(99 %)
