@@ -61,14 +61,16 @@ std::vector<PlaneDelta> reflective_plane_deltas(const ImageScores& with, const I
 }
 
 void print_timings(const RunTimings& t, const std::string& device) {
-  std::printf("timing (%s, ms/frame): load %.2f (ahead; waited %.2f) | raycast %.2f preprocess %.2f icp %.2f orb %.2f (mask %.2f) fuse %.2f identify %.2f"
-              " = pre-mapping %.2f | mapping %.2f ms/step (raycast %.1f densify %.1f optimise %.1f prune %.1f) x %lld"
-              " steps (%.2f ms/frame waited or inline) | wall %.2f ms/frame (%.2f FPS)\n",
-              device.c_str(), t.load_ms, t.load_wait_ms, t.mean.raycast, t.mean.preprocess, t.mean.icp, t.mean.orb, t.mean.mask,
-              t.mean.fuse,
-              t.mean.identify, t.premapping_ms, t.mapping_step_ms, t.mapping_raycast_ms, t.mapping_densify_ms,
-              t.mapping_optimise_ms, t.mapping_prune_ms, (long long)t.mapping_steps, t.mean.mapping,
-              t.wall_ms_per_frame, t.wall_ms_per_frame > 0 ? 1000.0 / t.wall_ms_per_frame : 0.0);
+  const OptimiseTimes& o = t.mapping_optimise;
+  std::printf("timing (%s, ms/frame): load %.2f (ahead; waited %.2f) | raycast %.2f preprocess %.2f icp %.2f"
+              " orb %.2f (mask %.2f) fuse %.2f identify %.2f = pre-mapping %.2f | mapping %.2f ms/step (raycast %.1f"
+              " densify %.1f optimise %.1f [render %.1f loss %.1f backward %.1f adam %.1f] prune %.1f) x %lld steps"
+              " (%.2f ms/frame waited or inline) | wall %.2f ms/frame (%.2f FPS)\n",
+              device.c_str(), t.load_ms, t.load_wait_ms, t.mean.raycast, t.mean.preprocess, t.mean.icp, t.mean.orb,
+              t.mean.mask, t.mean.fuse, t.mean.identify, t.premapping_ms, t.mapping_step_ms, t.mapping_raycast_ms,
+              t.mapping_densify_ms, t.mapping_optimise_ms, o.render, o.loss, o.backward, o.adam, t.mapping_prune_ms,
+              (long long)t.mapping_steps, t.mean.mapping, t.wall_ms_per_frame,
+              t.wall_ms_per_frame > 0 ? 1000.0 / t.wall_ms_per_frame : 0.0);
 }
 
 void run(const RunCliOptions& o) {

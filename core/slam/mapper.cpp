@@ -370,14 +370,22 @@ MappingStats GaussianMapper::run(std::shared_ptr<Prepared> prepared, const Mappi
     StepFrame& f = frames[order[size_t(it) % order.size()]];
     const bool pass3 = refl_.size() > 0 && f.shows_reflection;
     if (refl_.size() > 0 && !pass3) ++st.reflection_skipped;
+    auto tp = Clock::now();
     renderer_.render({K_, f.frame->T_wc}, base_, pass3 ? refl_ : no_reflection_, f.rc, out);
+    st.optimise.render += ms_since(tp);
+    tp = Clock::now();
     const bool with_refl = reflections && refl_.size() > 0;
     const LossValues L = mapping_loss(out.C, f.C_gt, out.D_b, f.D_gt, with_refl ? &out.C_r : nullptr, lw, up.v_C,
                                       up.v_D_b, up.v_C_r, loss_scratch_);
     loss_sum += L.total;
+    st.optimise.loss += ms_since(tp);
+    tp = Clock::now();
     renderer_.backward(up, v_base_, pass3 ? v_refl_ : v_no_reflection_);
+    st.optimise.backward += ms_since(tp);
+    tp = Clock::now();
     adam_base_.step(base_, v_base_);
     if (pass3) adam_refl_.step(refl_, v_refl_);
+    st.optimise.adam += ms_since(tp);
   }
   st.iterations = params_.iterations;
   st.frames = int(frames.size());

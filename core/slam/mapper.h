@@ -27,6 +27,7 @@
 #include "core/gaussians/reflective_plane.h"
 #include "core/render/render_types.h"
 #include "core/render/renderer.h"
+#include "core/slam/optimise_times.h"
 #include "core/slam/reflection_stereo.h"
 #include "core/tsdf/tsdf_raycast.h"
 
@@ -119,6 +120,7 @@ struct MappingStats {
   int reflection_skipped = 0;      // iterations whose view shows no reflection Gaussian's plane (pass 3 skipped)
   int planes_relabelled = 0;       // plane ids of reflection Gaussians moved to the canonical id of a merge
   double ms_raycast = 0, ms_densify = 0, ms_optimise = 0, ms_prune = 0, ms_total = 0;
+  OptimiseTimes optimise;          // ms_optimise by part
 };
 
 struct MapSnapshot {             // immutable for its readers (publish() reuses it once none holds it)

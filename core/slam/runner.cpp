@@ -263,6 +263,7 @@ RunResult run_dataset(const RunOptions& o) {
   t.mapping_raycast_ms = st.mapping.ms_raycast * per_step;
   t.mapping_densify_ms = st.mapping.ms_densify * per_step;
   t.mapping_optimise_ms = st.mapping.ms_optimise * per_step;
+  t.mapping_optimise = st.mapping.optimise.scaled(per_step);
   t.mapping_prune_ms = st.mapping.ms_prune * per_step;
   t.load_ms = loaded.produce_ms() / double(n);  // approximate after an interrupt (frames loaded ahead)
   t.load_wait_ms = loaded.wait_ms() / double(n);
@@ -416,6 +417,10 @@ std::string timings_json(const RunTimings& t, const std::string& device) {
   j["mapping_raycast_per_step"] = t.mapping_raycast_ms;
   j["mapping_densify_per_step"] = t.mapping_densify_ms;
   j["mapping_optimise_per_step"] = t.mapping_optimise_ms;
+  j["mapping_optimise_render_per_step"] = t.mapping_optimise.render;  // the four parts of mapping_optimise
+  j["mapping_optimise_loss_per_step"] = t.mapping_optimise.loss;
+  j["mapping_optimise_backward_per_step"] = t.mapping_optimise.backward;
+  j["mapping_optimise_adam_per_step"] = t.mapping_optimise.adam;
   j["mapping_prune_per_step"] = t.mapping_prune_ms;
   j["mapping_steps"] = t.mapping_steps;
   j["process_total"] = t.mean.total;

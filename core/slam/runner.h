@@ -82,6 +82,7 @@ struct RunTimings {
   double mapping_step_ms = 0;      // per mapping step (on the mapping thread unless sync)
   // Its stages per step: keyframe raycasts, densification, optimisation, pruning.
   double mapping_raycast_ms = 0, mapping_densify_ms = 0, mapping_optimise_ms = 0, mapping_prune_ms = 0;
+  OptimiseTimes mapping_optimise;  // mapping_optimise_ms by part, per step
   int64_t mapping_steps = 0;
   double load_ms = 0;              // dataset reading and decoding, per frame (on the loader threads)
   double load_wait_ms = 0;         // what the frame loop waited for a loaded frame, per frame

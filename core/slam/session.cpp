@@ -287,6 +287,7 @@ void Session::Impl::schedule_mapping(FrameReport& report) {
     mapping.ms_raycast += s.ms_raycast;
     mapping.ms_densify += s.ms_densify;
     mapping.ms_optimise += s.ms_optimise;
+    mapping.optimise += s.optimise;
     mapping.ms_prune += s.ms_prune;
     mapping.last_loss = s.loss;
     mapping.base_gaussians = int64_t(mapper.snapshot() ? mapper.snapshot()->base.size() : 0);

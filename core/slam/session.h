@@ -17,6 +17,7 @@
 #include "core/gaussians/gaussian_set.h"
 #include "core/gaussians/reflective_plane.h"
 #include "core/io/trajectory.h"
+#include "core/slam/optimise_times.h"
 #include "core/slam/session_config.h"
 #include "core/tracking/tracker.h"
 
@@ -92,6 +93,7 @@ struct MappingSummary {
   // Its stages, summed over steps (MappingStats): the keyframes' TSDF raycasts, densification,
   // the Adam iterations, pruning.
   double ms_raycast = 0, ms_densify = 0, ms_optimise = 0, ms_prune = 0;
+  OptimiseTimes optimise;          // ms_optimise by part, summed over steps
   double last_loss = 0;
 };
 

@@ -59,6 +59,21 @@ TEST(RunCli, WritesOutputsAndScoresGeometryOnTheObservedSurface) {
   EXPECT_GT(t.at("mapping_optimise_per_step").get<double>(), 0.0) << t.dump(2);
   EXPECT_LE(stages, t.at("mapping_step_per_step").get<double>() * 1.0001 + 1e-6) << t.dump(2);
   EXPECT_NE(r.output.find("optimise"), std::string::npos) << r.output;
+  // The optimisation's parts: each ran, and together they are most of it (the rest: choosing
+  // the frame, the loop itself).
+  double parts = 0;
+  for (const char* k : {"mapping_optimise_render_per_step", "mapping_optimise_loss_per_step",
+                        "mapping_optimise_backward_per_step", "mapping_optimise_adam_per_step"}) {
+    ASSERT_TRUE(t.contains(k)) << k;
+    EXPECT_GT(t.at(k).get<double>(), 0.0) << k;
+    parts += t.at(k).get<double>();
+  }
+  EXPECT_LE(parts, t.at("mapping_optimise_per_step").get<double>() * 1.0001 + 1e-6) << t.dump(2);
+  EXPECT_GE(parts, t.at("mapping_optimise_per_step").get<double>() * 0.9) << t.dump(2);
+  EXPECT_NE(r.output.find("backward"), std::string::npos) << r.output;
+  // The tracking mask's part of the ORB stage.
+  ASSERT_TRUE(t.contains("orb_mask"));
+  EXPECT_LE(t.at("orb_mask").get<double>(), t.at("orb").get<double>() * 1.0001 + 1e-6) << t.dump(2);
 
   const auto j = nlohmann::json::parse(std::ifstream(out / "metrics.json"));
   // The sensor kept every reflective surface of living_room (floor, TV, table): nothing filled.
