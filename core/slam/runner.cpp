@@ -249,12 +249,13 @@ RunResult run_dataset(const RunOptions& o) {
   RunTimings& t = result.timings;
   for (const FrameReport& r : reports) {
     t.mean.raycast += r.times.raycast, t.mean.preprocess += r.times.preprocess, t.mean.icp += r.times.icp;
-    t.mean.orb += r.times.orb, t.mean.mask += r.times.mask, t.mean.fuse += r.times.fuse, t.mean.identify += r.times.identify;
+    t.mean.orb += r.times.orb, t.mean.mask += r.times.mask, t.mean.fuse += r.times.fuse;
+    t.mean.identify += r.times.identify;
     t.mean.mapping += r.times.mapping, t.mean.total += r.times.total;
   }
   const double per = 1.0 / double(reports.size());
-  for (double* v : {&t.mean.raycast, &t.mean.preprocess, &t.mean.icp, &t.mean.orb, &t.mean.mask, &t.mean.fuse, &t.mean.identify,
-                    &t.mean.mapping, &t.mean.total})
+  for (double* v : {&t.mean.raycast, &t.mean.preprocess, &t.mean.icp, &t.mean.orb, &t.mean.mask, &t.mean.fuse,
+                    &t.mean.identify, &t.mean.mapping, &t.mean.total})
     *v *= per;
   t.premapping_ms = t.mean.raycast + t.mean.preprocess + t.mean.icp + t.mean.orb + t.mean.fuse + t.mean.identify;
   t.mapping_steps = st.mapping.steps;

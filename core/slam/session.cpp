@@ -147,10 +147,9 @@ RaycastResult Session::Impl::locked_raycast(const Intrinsics& K_, const Eigen::I
 ReflectionView Session::Impl::render_reflection(const Eigen::Isometry3f& T_wc, float stop_mean) {
   const auto snap = mapper.snapshot();
   const bool gaussians = snap && snap->reflection.size() > 0;
-  const std::vector<int32_t> unknown =
-      unmodelled_planes(snap ? std::span<const int32_t>(snap->reflection_planes) : std::span<const int32_t>{});
+  const std::vector<int32_t> unknown = unmodelled_planes(snap.get());
   ReflectionView view;
-  if (!gaussians && unknown.empty()) {
+  if (!mask_can_show(snap.get(), unknown)) {
     view.color = ColorImage(K.width, K.height, Color::Zero());
     return view;
   }
@@ -189,10 +188,12 @@ ReflectionView Session::Impl::render_reflection(const Eigen::Isometry3f& T_wc, f
 }
 
 // The planes whose reflection the model cannot render yet, sorted: the semantic candidates whose
-// vote is open, and the accepted planes (L_ref) without reflection Gaussians (`rendered`: the
-// snapshot's distinct plane ids of G_r). None without reflections (the base-only ablation keeps
-// the paper's mask, which is then empty) or with tracking.orb.mask_unmodelled off.
-std::vector<int32_t> Session::Impl::unmodelled_planes(std::span<const int32_t> rendered) const {
+// vote is open, and the accepted planes (L_ref) without reflection Gaussians in `snap` (null: none
+// yet). None without reflections (the base-only ablation keeps the paper's mask, which is then
+// empty) or with tracking.orb.mask_unmodelled off.
+std::vector<int32_t> Session::Impl::unmodelled_planes(const MapSnapshot* snap) const {
+  const std::span<const int32_t> rendered =
+      snap ? std::span<const int32_t>(snap->reflection_planes) : std::span<const int32_t>{};
   std::vector<int32_t> ids;
   if (!config.tracking.orb.mask_unmodelled || !config.mapping.reflections) return ids;
   ids.assign(undecided.begin(), undecided.end());
@@ -204,6 +205,11 @@ std::vector<int32_t> Session::Impl::unmodelled_planes(std::span<const int32_t> r
   std::sort(ids.begin(), ids.end());
   ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
   return ids;
+}
+
+// Whether the tracking mask can hold a pixel: reflection Gaussians render, or a plane is unmodelled.
+bool Session::Impl::mask_can_show(const MapSnapshot* snap, std::span<const int32_t> unmodelled) {
+  return (snap && snap->reflection.size() > 0) || !unmodelled.empty();
 }
 
 MappingContext Session::Impl::mapping_context() {
@@ -401,11 +407,9 @@ FrameReport Session::process(const SessionFrame& frame) {
       bool warp = s.masks && s.config.tracking.orb.mask_warp;
       if (warp) {
         const auto snap = s.mapper.snapshot();
-        warp = (snap && snap->reflection.size() > 0) ||
-               !s.unmodelled_planes(snap ? std::span<const int32_t>(snap->reflection_planes) : std::span<const int32_t>{})
-                    .empty();
+        warp = s.mask_can_show(snap.get(), s.unmodelled_planes(snap.get()));
       }
-      s.model.set_plane_ids(warp, warp ? std::span<const int32_t>(s.remap) : std::span<const int32_t>{});
+      s.model.set_plane_ids(warp, s.remap);
       s.model.model_at(s.T_last);
       report.times.raycast = ms_since(tr);
     }

@@ -83,7 +83,8 @@ struct Session::Impl {
                                RaycastOutputs outputs = RaycastOutputs::all()) const;
   // C_r for the tracking mask, exact where its mean RGB stays <= stop_mean (the mask's threshold)
   ReflectionView render_reflection(const Eigen::Isometry3f& T_wc, float stop_mean);
-  std::vector<int32_t> unmodelled_planes(std::span<const int32_t> rendered) const;
+  std::vector<int32_t> unmodelled_planes(const MapSnapshot* snap) const;
+  static bool mask_can_show(const MapSnapshot* snap, std::span<const int32_t> unmodelled);
   std::vector<int32_t> remap_copy() const {
     std::lock_guard lock(state_mutex);
     return remap;

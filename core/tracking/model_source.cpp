@@ -18,8 +18,8 @@ IcpModel TsdfModelSource::model_at(const Eigen::Isometry3f& T_wc) {
 void TsdfModelSource::set_plane_ids(bool on, std::span<const int32_t> remap) {
   if (on == plane_ids_ && (!on || std::equal(remap.begin(), remap.end(), remap_.begin(), remap_.end()))) return;
   plane_ids_ = on;
-  remap_.assign(remap.begin(), remap.end());
-  if (!on) remap_.clear();
+  if (on) remap_.assign(remap.begin(), remap.end());
+  else remap_.clear();
   valid_ = false;
 }
 

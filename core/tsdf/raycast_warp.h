@@ -1,8 +1,9 @@
 #pragma once
 // A raycast's plane-id map I moved to a nearby camera without marching again: each hit (its world
 // point V* and id) is projected into the new view and written to the pixels whose centres lie
-// within one pixel of it on both axes (one pixel when it is within 10⁻³ px of a centre) (at most 2 x 2, so no cracks open where the surface is
-// magnified up to twice), the nearest hit winning each pixel. Tracking's mask needs I at the ICP
+// within one pixel of it on both axes (at most 2 x 2, so no cracks open where the surface is
+// magnified up to twice; one pixel when it is within 10⁻³ px of a centre), the nearest hit winning
+// each pixel. Tracking's mask needs I at the ICP
 // pose, one frame's motion from the model raycast at T_{k−1} (docs/tracking.md). Pixels no hit
 // reaches (disoccluded, or beyond the source's edge) hold 0, no plane. The same pose and
 // intrinsics give the source's I back exactly. Runs on the device the raycast lives on.

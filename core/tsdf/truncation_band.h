@@ -12,8 +12,9 @@
 // Fusion stores t = min(1, sdf / ε(d)), so one voxel may hold averages of distances normalised by
 // different bands; its zero crossing, which is what raycasting and meshing read, stays an unbiased
 // estimate of the surface (each observation's sdf / ε(d) has the sign of its sdf), and far
-// observations weigh 1 / ε(d) as much as near ones, in step with their noise. The raycast steps by f · ε, which is at most the distance to
-// the surface when the band was wider (a shorter step, never an overshoot).
+// observations weigh 1 / ε(d) as much as near ones, in step with their noise. The raycast steps by
+// f · ε, which is at most the distance to the surface when the band was wider (a shorter step,
+// never an overshoot).
 #include "core/common/depth_noise_model.h"
 #include "core/common/hd.h"
 

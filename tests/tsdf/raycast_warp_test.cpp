@@ -17,7 +17,8 @@ namespace rrg {
 namespace {
 
 // A source raycast of n hits (depth > 0) at world points `p` with ids `ids`, as a 1-row image.
-RaycastResult hand_source(const std::vector<Eigen::Vector3f>& p, const std::vector<int32_t>& ids, const Device& device) {
+RaycastResult hand_source(const std::vector<Eigen::Vector3f>& p, const std::vector<int32_t>& ids,
+                          const Device& device) {
   const int n = int(p.size());
   Image<float> depth(n, 1);
   Image<Eigen::Vector3f> vertices(n, 1);
