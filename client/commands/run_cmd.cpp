@@ -30,7 +30,7 @@ struct RunCliOptions {
   std::vector<std::string> overrides;
   std::vector<size_t> decomposition;
   size_t max_frames = 0, train_stride = 10;
-  bool no_reflections = false, gt_poses = false, sync = false, ablate = false, no_progress = false;
+  bool no_reflections = false, gt_poses = false, sync = false, live = false, ablate = false, no_progress = false;
 };
 
 std::string opt_cm(const std::optional<double>& v) { return v ? fmt::format("{:.2f}", *v) : std::string("-"); }
@@ -65,11 +65,11 @@ void print_timings(const RunTimings& t, const std::string& device) {
   std::printf("timing (%s, ms/frame): load %.2f (ahead; waited %.2f) | raycast %.2f preprocess %.2f icp %.2f"
               " orb %.2f (mask %.2f) fuse %.2f identify %.2f = pre-mapping %.2f | mapping %.2f ms/step (raycast %.1f"
               " densify %.1f optimise %.1f [render %.1f loss %.1f backward %.1f adam %.1f] prune %.1f) x %lld steps"
-              " (%.2f ms/frame waited or inline) | wall %.2f ms/frame (%.2f FPS)\n",
+              " (%s, %lld waited for the one before; %.2f ms/frame waited or inline) | wall %.2f ms/frame (%.2f FPS)\n",
               device.c_str(), t.load_ms, t.load_wait_ms, t.mean.raycast, t.mean.preprocess, t.mean.icp, t.mean.orb,
               t.mean.mask, t.mean.fuse, t.mean.identify, t.premapping_ms, t.mapping_step_ms, t.mapping_raycast_ms,
               t.mapping_densify_ms, t.mapping_optimise_ms, o.render, o.loss, o.backward, o.adam, t.mapping_prune_ms,
-              (long long)t.mapping_steps, t.mean.mapping, t.wall_ms_per_frame,
+              (long long)t.mapping_steps, t.schedule.c_str(), (long long)t.mapping_waits, t.mean.mapping, t.wall_ms_per_frame,
               t.wall_ms_per_frame > 0 ? 1000.0 / t.wall_ms_per_frame : 0.0);
 }
 
@@ -86,6 +86,7 @@ void run(const RunCliOptions& o) {
   if (o.no_reflections) c.mapping.reflections = false;
   if (o.gt_poses) c.gt_poses = true;
   if (o.sync) c.sync = true;
+  if (o.live) c.live = true;
   if (!o.remote.empty()) c.remote_address = o.remote;
   ro.semantics = o.semantics;
   ro.max_frames = o.max_frames;
@@ -163,6 +164,8 @@ void register_run_command(CLI::App& app) {
   cmd->add_flag("--ablate-reflections", o->ablate, "also run with --no-reflections on the same frames; print both");
   cmd->add_flag("--gt-poses", o->gt_poses, "use the dataset's ground-truth poses (mapping only)");
   cmd->add_flag("--sync", o->sync, "deterministic: mapping steps inline at the same frame positions");
+  cmd->add_flag("--live", o->live, "pre-mapping never waits for a running mapping step (fewer steps where mapping is slower)")
+      ->excludes("--sync");
   cmd->add_option("--max-frames", o->max_frames, "stop after N frames (0 = all)")->capture_default_str();
   cmd->add_option("--train-stride", o->train_stride, "score every N-th frame as a training view (0 = none)")
       ->capture_default_str();

@@ -197,6 +197,7 @@ RunResult run_dataset(const RunOptions& o) {
   for (size_t i : o.decomposition_frames)  // before the run, not after an hour of it
     if (i >= n) throw std::invalid_argument("run: --decomposition frame " + std::to_string(i) + " is beyond the run (" +
                                             std::to_string(n) + " frames)");
+  config.validate();  // a refused config leaves no output folder behind
   if (!o.out.empty()) std::filesystem::create_directories(o.out);
   if (!o.out.empty())
     io::write_atomically(o.out / "config.yaml", [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << config_to_yaml(config); });
@@ -205,7 +206,7 @@ RunResult run_dataset(const RunOptions& o) {
   spdlog::info("run: {} ({} frames, {}x{}) on {}, tracking {}, semantics {}, reflections {}, {}", o.dataset.string(), n,
                config.K.width, config.K.height, config.device.to_string(),
                config.gt_poses ? "off (ground-truth poses)" : to_string(config.tracking.mode), config.semantics,
-               config.mapping.reflections ? "on" : "off", config.sync ? "sync" : "overlapped mapping");
+               config.mapping.reflections ? "on" : "off", to_string(config.schedule()) + " mapping");
 
   RunResult result;
   ProgressBar bar(n, o.progress);
@@ -247,6 +248,7 @@ RunResult run_dataset(const RunOptions& o) {
   const auto reports = session.reports();
   const SessionStatus st = session.status();
   RunTimings& t = result.timings;
+  t.schedule = to_string(config.schedule());
   for (const FrameReport& r : reports) {
     t.mean.raycast += r.times.raycast, t.mean.preprocess += r.times.preprocess, t.mean.icp += r.times.icp;
     t.mean.orb += r.times.orb, t.mean.mask += r.times.mask, t.mean.fuse += r.times.fuse;
@@ -259,6 +261,7 @@ RunResult run_dataset(const RunOptions& o) {
     *v *= per;
   t.premapping_ms = t.mean.raycast + t.mean.preprocess + t.mean.icp + t.mean.orb + t.mean.fuse + t.mean.identify;
   t.mapping_steps = st.mapping.steps;
+  t.mapping_waits = st.mapping.waits;
   const double per_step = st.mapping.steps ? 1.0 / double(st.mapping.steps) : 0.0;
   t.mapping_step_ms = st.mapping.ms_total * per_step;
   t.mapping_raycast_ms = st.mapping.ms_raycast * per_step;
@@ -424,6 +427,8 @@ std::string timings_json(const RunTimings& t, const std::string& device) {
   j["mapping_optimise_adam_per_step"] = t.mapping_optimise.adam;
   j["mapping_prune_per_step"] = t.mapping_prune_ms;
   j["mapping_steps"] = t.mapping_steps;
+  j["mapping_waits"] = t.mapping_waits;
+  j["schedule"] = t.schedule;
   j["process_total"] = t.mean.total;
   j["wall_per_frame"] = t.wall_ms_per_frame;
   j["fps"] = t.wall_ms_per_frame > 0 ? 1000.0 / t.wall_ms_per_frame : 0.0;

@@ -84,6 +84,8 @@ struct RunTimings {
   double mapping_raycast_ms = 0, mapping_densify_ms = 0, mapping_optimise_ms = 0, mapping_prune_ms = 0;
   OptimiseTimes mapping_optimise;  // mapping_optimise_ms by part, per step
   int64_t mapping_steps = 0;
+  int64_t mapping_waits = 0;       // steps that waited for the one before (MappingSummary::waits)
+  std::string schedule;            // sync, overlapped or live (mapping_schedule.h)
   double load_ms = 0;              // dataset reading and decoding, per frame (on the loader threads)
   double load_wait_ms = 0;         // what the frame loop waited for a loaded frame, per frame
   double premapping_ms = 0;        // raycast + preprocess + icp + orb + fuse + identify, per frame

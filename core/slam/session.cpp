@@ -53,10 +53,12 @@ void MappingWorker::start(std::function<void()> job) {
   cv_.notify_all();
 }
 
-void MappingWorker::wait() {
+bool MappingWorker::wait() {
   std::unique_lock lock(m_);
+  const bool was_running = running_;
   cv_.wait(lock, [&] { return !running_; });
   if (error_) std::rethrow_exception(std::exchange(error_, nullptr));
+  return was_running;
 }
 
 bool MappingWorker::busy() const {
@@ -113,9 +115,9 @@ Session::Impl::Impl(SessionConfig c, std::unique_ptr<SemanticCue> cue)
 
 Session::Session(SessionConfig config, std::unique_ptr<SemanticCue> cue)
     : impl_(std::make_unique<Impl>(std::move(config), std::move(cue))) {
-  spdlog::debug("session: {}x{} on {}, tracking {}, semantics {}, mapping every {} frames{}", impl_->K.width,
+  spdlog::debug("session: {}x{} on {}, tracking {}, semantics {}, mapping every {} frames ({})", impl_->K.width,
                 impl_->K.height, impl_->config.device.to_string(), to_string(impl_->config.tracking.mode),
-                impl_->identifier.cue().name(), impl_->config.mapping_period, impl_->config.sync ? " (sync)" : "");
+                impl_->identifier.cue().name(), impl_->config.mapping_period, to_string(impl_->config.schedule()));
 }
 
 Session::~Session() {
@@ -280,10 +282,15 @@ void Session::Impl::schedule_mapping(FrameReport& report) {
   const MappingContext ctx = mapping_context();
   std::shared_ptr<GaussianMapper::Prepared> prepared = mapper.prepare(ctx);
   std::exception_ptr failed;  // of the running step: reported after this one starts (its frames are consumed)
+  bool waited = false;
   try {
-    worker.wait();
+    waited = worker.wait();
   } catch (...) {
     failed = std::current_exception();
+  }
+  if (waited) {
+    std::lock_guard lock(state_mutex);
+    ++mapping.waits;
   }
   auto job = [this, ctx, prepared = std::move(prepared)]() mutable {
     const MappingStats s = mapper.run(std::move(prepared), ctx);
@@ -499,8 +506,9 @@ FrameReport Session::process(const SessionFrame& frame) {
     s.map_version.fetch_add(1);
     s.pending.push_back(MappingFrame{frame.index, report.T_wc, frame.color, *D_k});
     s.pending_keyframe.push_back(keyframe);
-    // 4. a mapping step every N_o fused frames (§4.2)
-    if (s.fused % s.config.mapping_period == 0) s.schedule_mapping(report);
+    // 4. a mapping step every N_o fused frames (§4.2; live: once N_o are queued and none runs)
+    if (mapping_due(s.config.schedule(), s.config.mapping_period, s.fused, s.pending.size(), s.worker.busy()))
+      s.schedule_mapping(report);
   } else {
     ++s.lost;
   }

@@ -7,7 +7,8 @@
 //                      variance check -> 5-window vote) and fusion of the reflection attributes;
 //   every N_o frames   a Gaussian mapping step (densify -> 30 iterations -> prune) on the mapping
 //                      thread, overlapping the next frames' pre-mapping (SessionConfig::sync = false),
-//                      or inline at the same frame positions (sync = true: deterministic).
+//                      or inline at the same frame positions (sync = true: deterministic); with
+//                      live = true pre-mapping never waits for a running step (mapping_schedule.h).
 // process() is called by one thread (the session's worker); every const query below may be called
 // from any thread at the same time (renders use the last published Gaussian snapshot and take the
 // volume lock only for the raycast).
@@ -88,6 +89,7 @@ struct SessionView {
 // Statistics of one mapping step, and their sums over a session.
 struct MappingSummary {
   int64_t steps = 0;
+  int64_t waits = 0;               // steps that waited for the one before to end (never with live)
   int64_t base_gaussians = 0, reflection_gaussians = 0;
   double ms_total = 0;             // summed over steps
   // Its stages, summed over steps (MappingStats): the keyframes' TSDF raycasts, densification,

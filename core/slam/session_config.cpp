@@ -138,6 +138,19 @@ TsdfParams SessionConfig::tsdf_params() const {
   return t;
 }
 
+MappingSchedule SessionConfig::schedule() const {
+  return sync ? MappingSchedule::Sync : (live ? MappingSchedule::Live : MappingSchedule::Overlapped);
+}
+
+std::string to_string(MappingSchedule s) {
+  switch (s) {
+    case MappingSchedule::Sync: return "sync";
+    case MappingSchedule::Overlapped: return "overlapped";
+    case MappingSchedule::Live: return "live";
+  }
+  return "?";
+}
+
 void SessionConfig::validate() const {
   if (!K.valid())
     throw std::invalid_argument("config intrinsics: need fx, fy > 0 and a positive image size (got " + K.to_string() + ")");
@@ -154,6 +167,8 @@ void SessionConfig::validate() const {
   if (plane_period < 1) throw std::invalid_argument("config plane_period: must be >= 1");
   if (mapping_period < 1) throw std::invalid_argument("config mapping_period: must be >= 1");
   if (final_steps < 0) throw std::invalid_argument("config final_steps: must be >= 0");
+  if (sync && live)
+    throw std::invalid_argument("config sync and live: choose one (sync runs every step inline, live never waits for one)");
   if (semantics != "none" && semantics != "labels" && semantics != "remote")
     throw std::invalid_argument("config semantics: '" + semantics + "' is not none, labels or remote");
   if (semantics == "remote" && remote_address.empty())
@@ -176,6 +191,7 @@ std::vector<ConfigField> config_fields(SessionConfig& c) {
   t.i("mapping_period", c.mapping_period, "N_o: Gaussian mapping step every N_o frames");
   t.i("final_steps", c.final_steps, "extra mapping steps over the keyframes at the end");
   t.b("sync", c.sync, "run mapping inline (deterministic) instead of on the mapping thread");
+  t.b("live", c.live, "overlapped mapping that pre-mapping never waits for: a step starts once N_o frames are queued and none runs");
   t.b("gt_poses", c.gt_poses, "use the frames' given poses (mapping only)");
   t.s("semantics", c.semantics, "semantic cue: none | labels | remote");
   t.s("remote_address", c.remote_address, "rrg.v1.Segmenter address (semantics = remote)");

@@ -7,6 +7,7 @@
 #include "core/common/device.h"
 #include "core/planes/plane_identification.h"
 #include "core/slam/mapper.h"
+#include "core/slam/mapping_schedule.h"
 #include "core/tracking/tracking_params.h"
 #include "core/tsdf/tsdf_params.h"
 
@@ -30,6 +31,7 @@ struct SessionConfig {
   int mapping_period = 10;             // N_o: a Gaussian mapping step every N_o frames
   int final_steps = 0;                 // extra mapping steps over the keyframes at finish()
   bool sync = false;                   // run mapping steps inline (deterministic) instead of overlapped
+  bool live = false;                   // overlapped without waiting for a running step (mapping_schedule.h)
   bool gt_poses = false;               // take SessionFrame::pose as the pose (mapping only, no tracking)
   std::string semantics = "labels";    // semantic cue: none | labels | remote
   std::string remote_address;          // rrg.v1.Segmenter address for semantics = remote
@@ -43,6 +45,7 @@ struct SessionConfig {
   TrackingParams tracking_params() const;
   // `tsdf` with the same sensor noise model for its truncation band ε(d) = max(ε, k σ_n(d)).
   TsdfParams tsdf_params() const;
+  MappingSchedule schedule() const;  // sync -> Sync, live -> Live, else Overlapped
 };
 
 // One named field of SessionConfig, typed by its text form.

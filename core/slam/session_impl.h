@@ -52,7 +52,7 @@ class MappingWorker {
   MappingWorker() = default;
   ~MappingWorker() { stop(); }
   void start(std::function<void()> job);  // starts the thread on first use; job runs on it
-  void wait();                            // until the current job (if any) finished
+  bool wait();                            // until the current job (if any) finished; whether one was running
   void stop();
   bool busy() const;
 

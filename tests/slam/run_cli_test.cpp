@@ -49,6 +49,8 @@ TEST(RunCli, WritesOutputsAndScoresGeometryOnTheObservedSurface) {
   // The mapping step's stages are reported, and they are parts of the step.
   const auto t = nlohmann::json::parse(std::ifstream(out / "timings.json"));
   ASSERT_GT(t.at("mapping_steps").get<int>(), 0) << t.dump(2);
+  EXPECT_EQ(t.at("schedule").get<std::string>(), "sync");
+  EXPECT_EQ(t.at("mapping_waits").get<int>(), 0);  // inline steps never wait for another
   double stages = 0;
   for (const char* k : {"mapping_raycast_per_step", "mapping_densify_per_step", "mapping_optimise_per_step",
                         "mapping_prune_per_step"}) {
@@ -114,6 +116,25 @@ TEST(RunCli, WritesOutputsAndScoresGeometryOnTheObservedSurface) {
     EXPECT_GT(e.at("psnr_db").get<double>(), 5.0);
     EXPECT_LT(e.at("psnr_db").get<double>(), 60.0);
   }
+}
+
+// --live and --sync exclude each other: refused before any work, naming both.
+TEST(RunCli, LiveAndSyncAreRefusedTogether) {
+  test::TempDir dir("run_cli_excl");
+  const auto seq = dir / "seq";
+  auto r = test::run_rrg("synth --preset office --frames 2 --width 160 --height 120 --novel 0 --out " + seq.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto out = dir / "run";
+  r = test::run_rrg("run --dataset " + seq.string() + " --out " + out.string() + " --live --sync --no-progress");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("--live"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--sync"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  // The same through the config (a YAML file or --set): the session's validation names both.
+  r = test::run_rrg("run --dataset " + seq.string() + " --out " + out.string() + " --sync --set live=true --no-progress");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("sync and live"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(out));
 }
 
 // Ctrl-C during a run: the run stops after the current frame and still writes every output over

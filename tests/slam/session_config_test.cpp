@@ -37,6 +37,33 @@ TEST(SessionConfig, DefaultsAreThePapers) {
   EXPECT_EQ(c.mapping.n_global, 7);
 }
 
+// The three mapping schedules (mapping_schedule.h): which config gives which, that sync and live
+// exclude each other, and when each starts a step.
+TEST(SessionConfig, MappingSchedules) {
+  SessionConfig c = camera_config();
+  EXPECT_EQ(c.schedule(), MappingSchedule::Overlapped);
+  apply_override(c, "live=true");
+  EXPECT_EQ(c.schedule(), MappingSchedule::Live);
+  EXPECT_NO_THROW(c.validate());
+  c.sync = true;
+  expect_rejected_naming(c, "live", "sync and live together");
+  c.live = false;
+  EXPECT_EQ(c.schedule(), MappingSchedule::Sync);
+  EXPECT_EQ(to_string(MappingSchedule::Live), "live");
+
+  // Sync and overlapped: every N_o-th fused frame, whatever is queued or running.
+  for (const MappingSchedule s : {MappingSchedule::Sync, MappingSchedule::Overlapped}) {
+    EXPECT_TRUE(mapping_due(s, 10, 20, 10, true));
+    EXPECT_TRUE(mapping_due(s, 10, 20, 25, false));
+    EXPECT_FALSE(mapping_due(s, 10, 21, 11, false));
+  }
+  // Live: once N_o frames are queued and no step runs, at any frame count.
+  EXPECT_FALSE(mapping_due(MappingSchedule::Live, 10, 20, 10, true));  // never waits for a running step
+  EXPECT_TRUE(mapping_due(MappingSchedule::Live, 10, 23, 13, false));  // the first frame after it ended
+  EXPECT_FALSE(mapping_due(MappingSchedule::Live, 10, 29, 9, false));  // fewer than N_o queued
+  EXPECT_TRUE(mapping_due(MappingSchedule::Live, 1, 1, 1, false));
+}
+
 TEST(SessionConfig, BadIntrinsicsNameTheField) {
   SessionConfig c;
   try {

@@ -394,6 +394,32 @@ TEST_F(SessionTest, RendersWhileMappingRuns) {
   EXPECT_GE(s.status().mapping.steps, 2);
 }
 
+// Live: pre-mapping never waits for a running step. Steps are made slow (200 iterations each, a
+// second or more here) against frames processed as fast as they come (tens of ms), so a step is
+// still running at the next N_o boundary: the overlapped schedule waits there, the live one goes
+// on, and its next step starts once the running one has ended, with every frame queued since.
+TEST_F(SessionTest, LiveMappingNeverWaitsForARunningStep) {
+  const auto d = io::open_dataset(root());
+  MappingSummary overlapped, live;
+  for (const bool is_live : {false, true}) {
+    SessionConfig c = config(*d);
+    c.sync = false;
+    c.live = is_live;
+    c.mapping.iterations = 200;
+    Session s(c);
+    run(s, *d, 24, false);
+    s.finish();  // maps the frames still queued
+    (is_live ? live : overlapped) = s.status().mapping;
+    EXPECT_EQ(s.status().fused, 24);
+    EXPECT_GT(s.status().mapping.base_gaussians, 0);
+  }
+  EXPECT_GE(overlapped.waits, 1);  // the step at frame 20 waited for the one from frame 10
+  EXPECT_EQ(overlapped.steps, 3);  // frames 10 and 20, and the 4 left at finish()
+  EXPECT_EQ(live.waits, 0);
+  EXPECT_GE(live.steps, 2);        // the first at frame 10, the queued rest at the latest at finish()
+  EXPECT_LT(live.steps, overlapped.steps);
+}
+
 TEST_F(SessionTest, SnapshotRestoresTheMapAndContinues) {
   const auto d = io::open_dataset(root());
   test::TempDir dir("snap");

@@ -1,0 +1,30 @@
+#pragma once
+// When a session starts a Gaussian mapping step (paper §4.2: every N_o fused frames), by schedule:
+//   Sync        inline, every N_o-th fused frame: deterministic (tests, the service's replays);
+//   Overlapped  on the mapping thread, every N_o-th fused frame; when the step before is still
+//               running there, pre-mapping waits for it, so every step of the paper's schedule runs
+//               and the frame rate falls to what mapping allows;
+//   Live        on the mapping thread, and pre-mapping never waits: at an N_o boundary a running
+//               step is left alone, the frames stay queued, and the next step starts after the
+//               first fused frame once it has ended, taking every queued frame (its N_local are
+//               sampled evenly from all of them). Where mapping keeps up (the GPU) this is the
+//               Overlapped schedule; where it does not (the CPU) tracking and fusion keep the
+//               stream's pace and the map gets fewer steps (docs/slam.md, "Schedules").
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace rrg {
+
+enum class MappingSchedule { Sync, Overlapped, Live };
+
+std::string to_string(MappingSchedule s);
+
+// Whether a step starts after a fused frame: `fused` frames fused so far, `queued` of them not yet
+// handed to a step, `running` whether a step is still running on the mapping thread. `period` N_o >= 1.
+inline bool mapping_due(MappingSchedule s, int period, int64_t fused, size_t queued, bool running) {
+  if (s == MappingSchedule::Live) return queued >= size_t(period) && !running;
+  return fused % period == 0;
+}
+
+}  // namespace rrg
