@@ -10,9 +10,11 @@
 //               sampled evenly from all of them). Where mapping keeps up (the GPU) this is the
 //               Overlapped schedule; where it does not (the CPU) tracking and fusion keep the
 //               stream's pace and the map gets fewer steps (docs/slam.md, "Schedules").
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace rrg {
 
@@ -25,6 +27,34 @@ std::string to_string(MappingSchedule s);
 inline bool mapping_due(MappingSchedule s, int period, int64_t fused, size_t queued, bool running) {
   if (s == MappingSchedule::Live) return queued >= size_t(period) && !running;
   return fused % period == 0;
+}
+
+// Live: the queue of frames waiting for the next step is bounded. A step uses of the frames since
+// the step before only N_local sampled evenly over them, and the keyframes among them (kept for
+// N_global): when more than kLiveQueueSteps · N_o are queued, every other non-keyframe is dropped
+// (the newest kept), which halves their density and keeps them evenly spread. The frames are in
+// the TSDF already; only their copies for the mapper go. Returns the positions to keep, in order;
+// all of them when the queue is within the bound.
+inline constexpr int kLiveQueueSteps = 4;
+
+inline std::vector<size_t> thin_live_queue(const std::vector<bool>& keyframe, int period) {
+  std::vector<size_t> keep;
+  const size_t n = keyframe.size();
+  if (n <= size_t(kLiveQueueSteps) * size_t(period)) {
+    for (size_t i = 0; i < n; ++i) keep.push_back(i);
+    return keep;
+  }
+  bool take = true;  // from the newest back: every other non-keyframe, the newest first
+  for (size_t i = n; i-- > 0;) {
+    if (keyframe[i]) {
+      keep.push_back(i);
+      continue;
+    }
+    if (take) keep.push_back(i);
+    take = !take;
+  }
+  std::reverse(keep.begin(), keep.end());
+  return keep;
 }
 
 }  // namespace rrg

@@ -268,6 +268,23 @@ void Session::Impl::identify(const SessionFrame& frame, const DepthImage& depth,
   report.times.identify += ms_since(t0);
 }
 
+// Live: the queue bounded (thin_live_queue, mapping_schedule.h); the dropped frames are counted.
+void Session::Impl::thin_queue() {
+  const std::vector<size_t> keep = thin_live_queue(pending_keyframe, config.mapping_period);
+  if (keep.size() == pending.size()) return;
+  std::vector<MappingFrame> frames;
+  std::vector<bool> flags;
+  for (size_t i : keep) {
+    frames.push_back(std::move(pending[i]));
+    flags.push_back(pending_keyframe[i]);
+  }
+  const int64_t dropped = int64_t(pending.size() - keep.size());
+  pending = std::move(frames);
+  pending_keyframe = std::move(flags);
+  std::lock_guard lock(state_mutex);
+  mapping.thinned += dropped;
+}
+
 // Hands the fused frames to the mapper and runs a step: inline (sync) or on the mapping thread.
 void Session::Impl::schedule_mapping(FrameReport& report) {
   const auto t0 = Clock::now();
@@ -506,6 +523,7 @@ FrameReport Session::process(const SessionFrame& frame) {
     s.map_version.fetch_add(1);
     s.pending.push_back(MappingFrame{frame.index, report.T_wc, frame.color, *D_k});
     s.pending_keyframe.push_back(keyframe);
+    if (s.config.schedule() == MappingSchedule::Live) s.thin_queue();
     // 4. a mapping step every N_o fused frames (§4.2; live: once N_o are queued and none runs)
     if (mapping_due(s.config.schedule(), s.config.mapping_period, s.fused, s.pending.size(), s.worker.busy()))
       s.schedule_mapping(report);
@@ -519,6 +537,7 @@ FrameReport Session::process(const SessionFrame& frame) {
   report.times.total = ms_since(t0);
   {
     std::lock_guard lock(s.state_mutex);
+    s.mapping.queued = int64_t(s.pending.size());
     s.trajectory.push_back({frame.timestamp, report.T_wc.cast<double>()});
     s.reports.push_back(report);
     s.state = report.state;
@@ -541,6 +560,8 @@ void Session::finish() {
       s.worker.wait();
     }
   }
+  std::lock_guard lock(s.state_mutex);
+  s.mapping.queued = int64_t(s.pending.size());
 }
 
 }  // namespace rrg

@@ -90,6 +90,8 @@ struct SessionView {
 struct MappingSummary {
   int64_t steps = 0;
   int64_t waits = 0;               // steps that waited for the one before to end (never with live)
+  int64_t thinned = 0;             // live: queued frames dropped before reaching a step (thin_live_queue)
+  int64_t queued = 0;              // fused frames waiting for the next step (after the last processed frame)
   int64_t base_gaussians = 0, reflection_gaussians = 0;
   double ms_total = 0;             // summed over steps
   // Its stages, summed over steps (MappingStats): the keyframes' TSDF raycasts, densification,

@@ -78,6 +78,7 @@ struct Session::Impl {
                 const Eigen::Isometry3f& T_wc, FrameReport& report, DeviceImage<int32_t>& plane_ids,
                 DeviceImage<uint8_t>& mask);
   void schedule_mapping(FrameReport& report);
+  void thin_queue();
   MappingContext mapping_context();
   RaycastResult locked_raycast(const Intrinsics& K, const Eigen::Isometry3f& T_wc,
                                RaycastOutputs outputs = RaycastOutputs::all()) const;

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 
 namespace rrg {
@@ -62,6 +63,28 @@ TEST(SessionConfig, MappingSchedules) {
   EXPECT_TRUE(mapping_due(MappingSchedule::Live, 10, 23, 13, false));  // the first frame after it ended
   EXPECT_FALSE(mapping_due(MappingSchedule::Live, 10, 29, 9, false));  // fewer than N_o queued
   EXPECT_TRUE(mapping_due(MappingSchedule::Live, 1, 1, 1, false));
+}
+
+// Live's queue bound: within 4 N_o frames nothing goes; beyond it every other non-keyframe goes,
+// from the newest back, and every keyframe and the newest frame stay.
+TEST(SessionConfig, TheLiveQueueIsThinnedEvenlyKeepingKeyframes) {
+  std::vector<bool> key(40, false);
+  EXPECT_EQ(thin_live_queue(key, 10).size(), 40u);
+  key.assign(41, false);
+  key[0] = key[20] = key[21] = true;
+  const std::vector<size_t> keep = thin_live_queue(key, 10);
+  EXPECT_EQ(keep.back(), 40u);  // the newest
+  for (size_t i : {size_t(0), size_t(20), size_t(21)}) EXPECT_NE(std::find(keep.begin(), keep.end(), i), keep.end()) << i;
+  EXPECT_TRUE(std::is_sorted(keep.begin(), keep.end()));
+  // 38 non-keyframes: 19 kept; never two neighbours among them both dropped or both kept.
+  EXPECT_EQ(keep.size(), 3u + 19u);
+  std::vector<size_t> plain;
+  for (size_t i = 0; i < key.size(); ++i)
+    if (!key[i]) plain.push_back(i);
+  for (size_t j = 0; j < plain.size(); ++j) {
+    const bool kept = std::find(keep.begin(), keep.end(), plain[j]) != keep.end();
+    EXPECT_EQ(kept, (plain.size() - 1 - j) % 2 == 0) << plain[j];
+  }
 }
 
 TEST(SessionConfig, BadIntrinsicsNameTheField) {

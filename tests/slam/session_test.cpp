@@ -411,6 +411,8 @@ TEST_F(SessionTest, LiveMappingNeverWaitsForARunningStep) {
     s.finish();  // maps the frames still queued
     (is_live ? live : overlapped) = s.status().mapping;
     EXPECT_EQ(s.status().fused, 24);
+    EXPECT_EQ(s.status().mapping.queued, 0);  // finish() handed every queued frame to a step
+    EXPECT_EQ(s.status().mapping.thinned, 0);  // 14 at most queued: within the live bound
     EXPECT_GT(s.status().mapping.base_gaussians, 0);
   }
   EXPECT_GE(overlapped.waits, 1);  // the step at frame 20 waited for the one from frame 10
