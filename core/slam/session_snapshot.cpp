@@ -279,6 +279,7 @@ std::unique_ptr<Session> Session::load(const std::filesystem::path& file, std::u
       s.pending.push_back(c.pending[i].expand());
       s.pending_keyframe.push_back(c.pending_keyframe[i] != 0);
     }
+    s.mapping.queued = int64_t(s.pending.size());
     s.tracker_keyframes = s.tracker.keyframes().size();
     s.fill_regions = std::move(c.fill_regions);
     s.undecided = std::set<int>(c.undecided_planes.begin(), c.undecided_planes.end());

@@ -103,6 +103,8 @@ TEST_F(SnapshotTest, ALoadedSessionContinuesLikeTheUninterruptedOne) {
     ASSERT_GT(at_save.mapping.reflection_gaussians, 0) << "the test needs reflection Gaussians before the split";
     loaded = Session::load(dir / "s.rrgs");
     EXPECT_EQ(loaded->status().keyframes, first.status().keyframes);
+    EXPECT_EQ(at_save.mapping.queued, 2);  // the frames pending at the split travel with the snapshot
+    EXPECT_EQ(loaded->status().mapping.queued, at_save.mapping.queued);
   }
   run(*loaded, *d, kSplit, kFrames);
   loaded->finish();
