@@ -30,6 +30,7 @@ struct RunCliOptions {
   std::vector<std::string> overrides;
   std::vector<size_t> decomposition;
   size_t max_frames = 0, train_stride = 10;
+  double rate = 0;
   bool no_reflections = false, gt_poses = false, sync = false, live = false, ablate = false, no_progress = false;
 };
 
@@ -65,12 +66,13 @@ void print_timings(const RunTimings& t, const std::string& device) {
   std::printf("timing (%s, ms/frame): load %.2f (ahead; waited %.2f) | raycast %.2f preprocess %.2f icp %.2f"
               " orb %.2f (mask %.2f) fuse %.2f identify %.2f = pre-mapping %.2f | mapping %.2f ms/step (raycast %.1f"
               " densify %.1f optimise %.1f [render %.1f loss %.1f backward %.1f adam %.1f] prune %.1f) x %lld steps"
-              " (%s, %lld waited for the one before; %.2f ms/frame waited or inline) | wall %.2f ms/frame (%.2f FPS)\n",
+              " (%s, %lld waited for the one before; %.2f ms/frame waited or inline) | wall %.2f ms/frame (%.2f FPS%s)\n",
               device.c_str(), t.load_ms, t.load_wait_ms, t.mean.raycast, t.mean.preprocess, t.mean.icp, t.mean.orb,
               t.mean.mask, t.mean.fuse, t.mean.identify, t.premapping_ms, t.mapping_step_ms, t.mapping_raycast_ms,
               t.mapping_densify_ms, t.mapping_optimise_ms, o.render, o.loss, o.backward, o.adam, t.mapping_prune_ms,
               (long long)t.mapping_steps, t.schedule.c_str(), (long long)t.mapping_waits, t.mean.mapping, t.wall_ms_per_frame,
-              t.wall_ms_per_frame > 0 ? 1000.0 / t.wall_ms_per_frame : 0.0);
+              t.wall_ms_per_frame > 0 ? 1000.0 / t.wall_ms_per_frame : 0.0,
+              t.rate_hz > 0 ? fmt::format("; input at most {:g} Hz", t.rate_hz).c_str() : "");
 }
 
 void run(const RunCliOptions& o) {
@@ -90,6 +92,7 @@ void run(const RunCliOptions& o) {
   if (!o.remote.empty()) c.remote_address = o.remote;
   ro.semantics = o.semantics;
   ro.max_frames = o.max_frames;
+  ro.rate_hz = o.rate;
   ro.train_stride = o.train_stride;
   ro.decomposition_frames = o.decomposition;
   ro.render_poses = o.render_poses;
@@ -167,6 +170,8 @@ void register_run_command(CLI::App& app) {
   cmd->add_flag("--live", o->live, "pre-mapping never waits for a running mapping step (fewer steps where mapping is slower)")
       ->excludes("--sync");
   cmd->add_option("--max-frames", o->max_frames, "stop after N frames (0 = all)")->capture_default_str();
+  cmd->add_option("--rate", o->rate, "feed frames at most this many per second, as a sensor streams (0 = as fast as they load)")
+      ->capture_default_str();
   cmd->add_option("--train-stride", o->train_stride, "score every N-th frame as a training view (0 = none)")
       ->capture_default_str();
   cmd->add_option("--decomposition", o->decomposition, "frames whose C_b, R, R*C_r, C and ground truth are written")

@@ -197,6 +197,8 @@ RunResult run_dataset(const RunOptions& o) {
   for (size_t i : o.decomposition_frames)  // before the run, not after an hour of it
     if (i >= n) throw std::invalid_argument("run: --decomposition frame " + std::to_string(i) + " is beyond the run (" +
                                             std::to_string(n) + " frames)");
+  if (!(o.rate_hz >= 0) || !std::isfinite(o.rate_hz))
+    throw std::invalid_argument("run: --rate must be a frame rate >= 0 (0 = as fast as frames load)");
   config.validate();  // a refused config leaves no output folder behind
   if (!o.out.empty()) std::filesystem::create_directories(o.out);
   if (!o.out.empty())
@@ -229,6 +231,9 @@ RunResult run_dataset(const RunOptions& o) {
       n, loaders + 2, loaders);
   for (size_t i = 0; i < n; ++i) {
     SessionFrame frame = loaded.next();
+    if (o.rate_hz > 0)  // a sensor's stream: frame i arrives i / rate after the first
+      std::this_thread::sleep_until(wall0 + std::chrono::duration_cast<Clock::duration>(
+                                                std::chrono::duration<double>(double(i) / o.rate_hz)));
     const FrameReport r = session.process(frame);
     if (r.state == TrackingState::Lost) spdlog::debug("run: frame {} lost: {}", i, r.note);
     if (o.train_stride > 0 && i % o.train_stride == 0) train_views.emplace_back(i, std::move(frame.color));
@@ -249,6 +254,7 @@ RunResult run_dataset(const RunOptions& o) {
   const SessionStatus st = session.status();
   RunTimings& t = result.timings;
   t.schedule = to_string(config.schedule());
+  t.rate_hz = o.rate_hz;
   for (const FrameReport& r : reports) {
     t.mean.raycast += r.times.raycast, t.mean.preprocess += r.times.preprocess, t.mean.icp += r.times.icp;
     t.mean.orb += r.times.orb, t.mean.mask += r.times.mask, t.mean.fuse += r.times.fuse;
@@ -429,6 +435,7 @@ std::string timings_json(const RunTimings& t, const std::string& device) {
   j["mapping_steps"] = t.mapping_steps;
   j["mapping_waits"] = t.mapping_waits;
   j["schedule"] = t.schedule;
+  j["rate_hz"] = t.rate_hz;
   j["process_total"] = t.mean.total;
   j["wall_per_frame"] = t.wall_ms_per_frame;
   j["fps"] = t.wall_ms_per_frame > 0 ? 1000.0 / t.wall_ms_per_frame : 0.0;

@@ -23,6 +23,8 @@ struct RunOptions {
   SessionConfig config;                      // K is taken from the dataset
   std::string semantics = "auto";            // auto: labels when the dataset has label images, else none
   size_t max_frames = 0;                     // 0 = all
+  double rate_hz = 0;                        // frame i is fed no earlier than i / rate_hz after the start,
+                                             // as a sensor streams; 0 = as fast as frames load
   size_t train_stride = 10;                  // every N-th frame is scored as a training view
   std::vector<size_t> decomposition_frames;  // frames whose C_b, R, R·C_r, C and GT images are written
   std::filesystem::path render_poses;        // file of poses to render at the end
@@ -86,6 +88,7 @@ struct RunTimings {
   int64_t mapping_steps = 0;
   int64_t mapping_waits = 0;       // steps that waited for the one before (MappingSummary::waits)
   std::string schedule;            // sync, overlapped or live (mapping_schedule.h)
+  double rate_hz = 0;              // RunOptions::rate_hz (0: frames fed as fast as they load)
   double load_ms = 0;              // dataset reading and decoding, per frame (on the loader threads)
   double load_wait_ms = 0;         // what the frame loop waited for a loaded frame, per frame
   double premapping_ms = 0;        // raycast + preprocess + icp + orb + fuse + identify, per frame

@@ -137,6 +137,30 @@ TEST(RunCli, LiveAndSyncAreRefusedTogether) {
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
+// --rate feeds frame i no earlier than i / rate after the start, as a sensor streams: 6 frames at
+// 20 Hz take at least 5 / 20 s, so the run's frame rate is at most 6 / (5 / 20) = 24 FPS however
+// fast the machine. A negative rate is refused before any output is written.
+TEST(RunCli, RateFeedsFramesNoFasterThanASensor) {
+  test::TempDir dir("run_cli_rate");
+  const auto seq = dir / "seq";
+  auto r = test::run_rrg("synth --preset office --frames 6 --width 160 --height 120 --novel 0 --out " + seq.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto out = dir / "run";
+  r = test::run_rrg("run --dataset " + seq.string() + " --out " + out.string() +
+                    " --live --rate 20 --device cpu --no-progress --set tsdf.voxel_size=0.02 --set tsdf.truncation=0.08");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto t = nlohmann::json::parse(std::ifstream(out / "timings.json"));
+  EXPECT_EQ(t.at("rate_hz").get<double>(), 20.0);
+  EXPECT_EQ(t.at("schedule").get<std::string>(), "live");
+  EXPECT_LE(t.at("fps").get<double>(), 24.0) << t.dump(2);
+  EXPECT_NE(r.output.find("input at most 20 Hz"), std::string::npos) << r.output;
+  const auto bad = dir / "bad";
+  r = test::run_rrg("run --dataset " + seq.string() + " --out " + bad.string() + " --rate -1 --no-progress");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("--rate"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(bad));
+}
+
 // Ctrl-C during a run: the run stops after the current frame and still writes every output over
 // the frames it processed, says so in metrics.json, and exits with 128 + SIGINT.
 TEST(RunCli, InterruptStopsAfterTheCurrentFrameAndWritesTheOutputs) {
