@@ -72,7 +72,9 @@ void print_timings(const RunTimings& t, const std::string& device) {
               t.mapping_densify_ms, t.mapping_optimise_ms, o.render, o.loss, o.backward, o.adam, t.mapping_prune_ms,
               (long long)t.mapping_steps, t.schedule.c_str(), (long long)t.mapping_waits, t.mean.mapping, t.wall_ms_per_frame,
               t.wall_ms_per_frame > 0 ? 1000.0 / t.wall_ms_per_frame : 0.0,
-              t.rate_hz > 0 ? fmt::format("; input at most {:g} Hz", t.rate_hz).c_str() : "");
+              t.rate_hz > 0 ? fmt::format("; input at most {:g} Hz, latency mean {:.1f} max {:.1f} ms", t.rate_hz,
+                                           t.latency_mean_ms, t.latency_max_ms).c_str()
+                            : "");
 }
 
 void run(const RunCliOptions& o) {

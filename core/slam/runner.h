@@ -89,6 +89,7 @@ struct RunTimings {
   int64_t mapping_waits = 0;       // steps that waited for the one before (MappingSummary::waits)
   std::string schedule;            // sync, overlapped or live (mapping_schedule.h)
   double rate_hz = 0;              // RunOptions::rate_hz (0: frames fed as fast as they load)
+  double latency_mean_ms = 0, latency_max_ms = 0;  // with rate_hz > 0: a frame's arrival to process() returning
   double load_ms = 0;              // dataset reading and decoding, per frame (on the loader threads)
   double load_wait_ms = 0;         // what the frame loop waited for a loaded frame, per frame
   double premapping_ms = 0;        // raycast + preprocess + icp + orb + fuse + identify, per frame

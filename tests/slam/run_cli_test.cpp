@@ -153,6 +153,9 @@ TEST(RunCli, RateFeedsFramesNoFasterThanASensor) {
   EXPECT_EQ(t.at("rate_hz").get<double>(), 20.0);
   EXPECT_EQ(t.at("schedule").get<std::string>(), "live");
   EXPECT_LE(t.at("fps").get<double>(), 24.0) << t.dump(2);
+  // Each frame's latency runs from its arrival to its pose: positive, the mean within the maximum.
+  EXPECT_GT(t.at("input_latency_mean_ms").get<double>(), 0.0);
+  EXPECT_LE(t.at("input_latency_mean_ms").get<double>(), t.at("input_latency_max_ms").get<double>());
   EXPECT_NE(r.output.find("input at most 20 Hz"), std::string::npos) << r.output;
   const auto bad = dir / "bad";
   r = test::run_rrg("run --dataset " + seq.string() + " --out " + bad.string() + " --rate -1 --no-progress");
