@@ -9,7 +9,7 @@
 //               first fused frame once it has ended, taking every queued frame (its N_local are
 //               sampled evenly from all of them). Where mapping keeps up (the GPU) this is the
 //               Overlapped schedule; where it does not (the CPU) tracking and fusion keep the
-//               stream's pace and the map gets fewer steps (docs/slam.md, "Schedules").
+//               stream's pace and the map gets fewer steps (docs/slam.md, "Schedule").
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
