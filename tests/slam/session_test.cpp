@@ -417,9 +417,9 @@ TEST_F(SessionTest, LiveMappingNeverWaitsForARunningStep) {
   }
   EXPECT_GE(overlapped.waits, 1);  // the step at frame 20 waited for the one from frame 10
   EXPECT_EQ(overlapped.steps, 3);  // frames 10 and 20, and the 4 left at finish()
-  EXPECT_EQ(live.waits, 0);
+  EXPECT_EQ(live.waits, 0);        // whatever the timing: a live step starts only when none runs
   EXPECT_GE(live.steps, 2);        // the first at frame 10, the queued rest at the latest at finish()
-  EXPECT_LT(live.steps, overlapped.steps);
+  EXPECT_LE(live.steps, overlapped.steps);  // 2 when the first step outlasts frames 11-24, as here
 }
 
 TEST_F(SessionTest, SnapshotRestoresTheMapAndContinues) {
