@@ -235,10 +235,11 @@ RunResult run_dataset(const RunOptions& o) {
     // process() returns (a session that keeps up holds it near one frame's pre-mapping).
     const auto due = wall0 + std::chrono::duration_cast<Clock::duration>(
                                  std::chrono::duration<double>(o.rate_hz > 0 ? double(i) / o.rate_hz : 0.0));
-    if (o.rate_hz > 0) std::this_thread::sleep_until(due);
+    while (o.rate_hz > 0 && Clock::now() < due && !(o.stop && o.stop()))  // Ctrl-C stays prompt at slow rates
+      std::this_thread::sleep_for(std::min<Clock::duration>(due - Clock::now(), std::chrono::milliseconds(100)));
     const FrameReport r = session.process(frame);
     if (o.rate_hz > 0) {
-      const double latency = ms_since(due);
+      const double latency = std::max(0.0, ms_since(due));  // (a frame a stop let in early: 0)
       result.timings.latency_mean_ms += latency;
       result.timings.latency_max_ms = std::max(result.timings.latency_max_ms, latency);
     }

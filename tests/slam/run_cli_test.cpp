@@ -164,6 +164,27 @@ TEST(RunCli, RateFeedsFramesNoFasterThanASensor) {
   EXPECT_FALSE(std::filesystem::exists(bad));
 }
 
+// Ctrl-C while --rate waits for the next frame (here 2000 s away): the wait ends at once, that frame
+// is processed and the run finishes as after any Ctrl-C. Without that, this test would sit out
+// CTest's 900 s timeout and fail.
+TEST(RunCli, CtrlCEndsARateWait) {
+  test::TempDir dir("run_cli_rate_stop");
+  const auto seq = dir / "seq";
+  auto r = test::run_rrg("synth --preset office --frames 3 --width 160 --height 120 --novel 0 --out " + seq.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto out = dir / "run";
+  test::BackgroundRrg rrg("run --dataset " + seq.string() + " --out " + out.string() +
+                              " --live --rate 0.0005 --device cpu --no-progress --set tsdf.voxel_size=0.02"
+                              " --set tsdf.truncation=0.08",
+                          dir / "log.txt");
+  ASSERT_TRUE(rrg.wait_for_output("run: ")) << "rrg run did not start";
+  rrg.signal(SIGINT);
+  EXPECT_EQ(rrg.wait(), 128 + SIGINT);
+  const auto j = nlohmann::json::parse(std::ifstream(out / "metrics.json"));
+  EXPECT_TRUE(j.at("interrupted").get<bool>());
+  EXPECT_LE(j.at("frames").get<size_t>(), 2u);  // frame 0, and at most the frame the stop let in
+}
+
 // Ctrl-C during a run: the run stops after the current frame and still writes every output over
 // the frames it processed, says so in metrics.json, and exits with 128 + SIGINT.
 TEST(RunCli, InterruptStopsAfterTheCurrentFrameAndWritesTheOutputs) {
