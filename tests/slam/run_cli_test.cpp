@@ -16,18 +16,28 @@
 namespace rrg {
 namespace {
 
+// A 160x120 `rrg synth` sequence in dir/seq (empty path when synth failed; the failure is reported).
+std::filesystem::path synth(const test::TempDir& dir, const std::string& preset, int frames, int novel,
+                            const std::string& extra = "") {
+  const auto seq = dir / "seq";
+  const auto r = test::run_rrg("synth --preset " + preset + " --frames " + std::to_string(frames) +
+                               " --width 160 --height 120 --novel " + std::to_string(novel) + extra + " --out " +
+                               seq.string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  return r.exit_code == 0 ? seq : std::filesystem::path();
+}
+
 // Frames are decoded ahead on loader threads; a frame that cannot be read must still stop the run
 // at that frame, with an error naming the file, after the frames before it were processed.
 TEST(RunCli, AnUnreadableFrameStopsTheRunAndNamesTheFile) {
   test::TempDir dir("run_cli_bad");
-  const auto seq = dir / "seq";
-  auto r = test::run_rrg("synth --preset living_room --frames 12 --width 160 --height 120 --novel 1 --out " + seq.string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto seq = synth(dir, "living_room", 12, 1);
+  ASSERT_FALSE(seq.empty());
   const auto bad = seq / "depth" / "000007.png";
   ASSERT_TRUE(std::filesystem::exists(bad));
   std::ofstream(bad, std::ios::trunc) << "not a png";
-  r = test::run_rrg("-v run --dataset " + seq.string() + " --out " + (dir / "run").string() +
-                    " --device cpu --sync --gt-poses --no-progress --set tsdf.voxel_size=0.02 --set tsdf.truncation=0.08");
+  auto r = test::run_rrg("-v run --dataset " + seq.string() + " --out " + (dir / "run").string() +
+                         " --device cpu --sync --gt-poses --no-progress --set tsdf.voxel_size=0.02 --set tsdf.truncation=0.08");
   EXPECT_NE(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("000007.png"), std::string::npos) << r.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "run" / "metrics.json")) << "no metrics for a run that did not finish";
@@ -35,13 +45,11 @@ TEST(RunCli, AnUnreadableFrameStopsTheRunAndNamesTheFile) {
 
 TEST(RunCli, WritesOutputsAndScoresGeometryOnTheObservedSurface) {
   test::TempDir dir("run_cli");
-  const auto seq = dir / "seq";
-  auto r = test::run_rrg("synth --preset living_room --frames 20 --width 160 --height 120 --novel 2 --noise --out " +
-                         seq.string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto seq = synth(dir, "living_room", 20, 2, " --noise");
+  ASSERT_FALSE(seq.empty());
   const auto out = dir / "run";
-  r = test::run_rrg("run --dataset " + seq.string() + " --out " + out.string() +
-                    " --device cpu --sync --gt-poses --no-progress --set tsdf.voxel_size=0.02 --set tsdf.truncation=0.08");
+  auto r = test::run_rrg("run --dataset " + seq.string() + " --out " + out.string() +
+                         " --device cpu --sync --gt-poses --no-progress --set tsdf.voxel_size=0.02 --set tsdf.truncation=0.08");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   for (const char* f : {"trajectory.txt", "mesh.ply", "mesh.drc", "metrics.json", "timings.json", "config.yaml"})
     EXPECT_TRUE(std::filesystem::exists(out / f)) << f;
@@ -121,11 +129,10 @@ TEST(RunCli, WritesOutputsAndScoresGeometryOnTheObservedSurface) {
 // --live and --sync exclude each other: refused before any work, naming both.
 TEST(RunCli, LiveAndSyncAreRefusedTogether) {
   test::TempDir dir("run_cli_excl");
-  const auto seq = dir / "seq";
-  auto r = test::run_rrg("synth --preset office --frames 2 --width 160 --height 120 --novel 0 --out " + seq.string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto seq = synth(dir, "office", 2, 0);
+  ASSERT_FALSE(seq.empty());
   const auto out = dir / "run";
-  r = test::run_rrg("run --dataset " + seq.string() + " --out " + out.string() + " --live --sync --no-progress");
+  auto r = test::run_rrg("run --dataset " + seq.string() + " --out " + out.string() + " --live --sync --no-progress");
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.output.find("--live"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("--sync"), std::string::npos) << r.output;
@@ -142,12 +149,11 @@ TEST(RunCli, LiveAndSyncAreRefusedTogether) {
 // fast the machine. A negative rate is refused before any output is written.
 TEST(RunCli, RateFeedsFramesNoFasterThanASensor) {
   test::TempDir dir("run_cli_rate");
-  const auto seq = dir / "seq";
-  auto r = test::run_rrg("synth --preset office --frames 6 --width 160 --height 120 --novel 0 --out " + seq.string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto seq = synth(dir, "office", 6, 0);
+  ASSERT_FALSE(seq.empty());
   const auto out = dir / "run";
-  r = test::run_rrg("run --dataset " + seq.string() + " --out " + out.string() +
-                    " --live --rate 20 --device cpu --no-progress --set tsdf.voxel_size=0.02 --set tsdf.truncation=0.08");
+  auto r = test::run_rrg("run --dataset " + seq.string() + " --out " + out.string() +
+                         " --live --rate 20 --device cpu --no-progress --set tsdf.voxel_size=0.02 --set tsdf.truncation=0.08");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto t = nlohmann::json::parse(std::ifstream(out / "timings.json"));
   EXPECT_EQ(t.at("rate_hz").get<double>(), 20.0);
@@ -169,9 +175,8 @@ TEST(RunCli, RateFeedsFramesNoFasterThanASensor) {
 // CTest's 900 s timeout and fail.
 TEST(RunCli, CtrlCEndsARateWait) {
   test::TempDir dir("run_cli_rate_stop");
-  const auto seq = dir / "seq";
-  auto r = test::run_rrg("synth --preset office --frames 3 --width 160 --height 120 --novel 0 --out " + seq.string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto seq = synth(dir, "office", 3, 0);
+  ASSERT_FALSE(seq.empty());
   const auto out = dir / "run";
   test::BackgroundRrg rrg("run --dataset " + seq.string() + " --out " + out.string() +
                               " --live --rate 0.0005 --device cpu --no-progress --set tsdf.voxel_size=0.02"
@@ -189,9 +194,8 @@ TEST(RunCli, CtrlCEndsARateWait) {
 // the frames it processed, says so in metrics.json, and exits with 128 + SIGINT.
 TEST(RunCli, InterruptStopsAfterTheCurrentFrameAndWritesTheOutputs) {
   test::TempDir dir("run_cli_interrupt");
-  const auto seq = dir / "seq";
-  auto r = test::run_rrg("synth --preset living_room --frames 30 --width 160 --height 120 --novel 0 --out " + seq.string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto seq = synth(dir, "living_room", 30, 0);
+  ASSERT_FALSE(seq.empty());
   const auto out = dir / "run";
   test::BackgroundRrg rrg("run --dataset " + seq.string() + " --out " + out.string() +
                               " --device cpu --sync --no-progress --set tsdf.voxel_size=0.02 --set tsdf.truncation=0.08",
