@@ -270,6 +270,7 @@ void Session::Impl::identify(const SessionFrame& frame, const DepthImage& depth,
 
 // Live: the queue bounded (thin_live_queue, mapping_schedule.h); the dropped frames are counted.
 void Session::Impl::thin_queue() {
+  if (pending.size() <= size_t(kLiveQueueSteps) * size_t(config.mapping_period)) return;  // the usual case: no copy
   const std::vector<size_t> keep = thin_live_queue(pending_keyframe, config.mapping_period);
   if (keep.size() == pending.size()) return;
   std::vector<MappingFrame> frames;
