@@ -141,8 +141,9 @@ class GaussianMapper {
   // (queued or keyframe) it only republishes. Not re-entrant (one step at a time).
   // step() = run(prepare()). prepare() selects the step's frames (consuming the queued ones) and
   // runs pass 1 at each through ctx.raycast; it reads no Gaussian, so the session runs it on the
-  // pre-mapping thread while the previous step's run() optimises (docs/slam.md). Prepared steps
-  // must be run in the order they were prepared; run() throws std::invalid_argument for a null one.
+  // pre-mapping thread while the previous step's run() optimises (live: on the mapping thread,
+  // just before run(); docs/slam.md). Prepared steps must be run in the order they were prepared;
+  // run() throws std::invalid_argument for a null one.
   struct Prepared;
   std::shared_ptr<Prepared> prepare(const MappingContext& ctx);
   MappingStats run(std::shared_ptr<Prepared> prepared, const MappingContext& ctx);

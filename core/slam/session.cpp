@@ -216,15 +216,22 @@ bool Session::Impl::mask_can_show(const MapSnapshot* snap, std::span<const int32
 
 MappingContext Session::Impl::mapping_context() {
   MappingContext ctx;
-  // The mapper reads D_t, C_t, I, R and C_var (to_inputs, densify), never V* or N*.
-  ctx.raycast = [this](const Intrinsics& K_, const Eigen::Isometry3f& T_wc) {
-    return locked_raycast(K_, T_wc, RaycastOutputs{.color = true, .reflection = true, .normals = false});
-  };
-  if (config.mapping.reflections) {
+  std::vector<int32_t> ids;  // the remap table of the step's raycasts, taken with its planes
+  {
     std::lock_guard lock(state_mutex);
-    for (const ReflectivePlane& p : reflective) ctx.planes.push_back({p.id, p.plane});
-    ctx.remap = remap;  // as locked_raycast reads it: identification runs on this thread too
+    ids = remap;
+    if (config.mapping.reflections) {
+      for (const ReflectivePlane& p : reflective) ctx.planes.push_back({p.id, p.plane});
+      ctx.remap = remap;
+    }
   }
+  // The mapper reads D_t, C_t, I, R and C_var (to_inputs, densify), never V* or N*. The raycasts
+  // keep the table taken here whichever thread runs them: a live step prepares on the mapping
+  // thread, after identifications that may have merged planes since.
+  ctx.raycast = [this, ids = std::move(ids)](const Intrinsics& K_, const Eigen::Isometry3f& T_wc) {
+    std::shared_lock lock(volume_mutex);
+    return raycast(volume, K_, T_wc, ids, RaycastOutputs{.color = true, .reflection = true, .normals = false});
+  };
   return ctx;
 }
 
@@ -293,12 +300,14 @@ void Session::Impl::schedule_mapping(FrameReport& report) {
   // selected and pass 1 raycast on this (pre-mapping) thread, from the TSDF as fused up to this
   // frame, while a running step still optimises (it chose its frames when it was prepared). Then
   // the step's remaining work waits for the running one and goes to the mapping thread (inline
-  // with --sync, in the same order).
+  // with --sync, in the same order). Live, no step runs here (mapping_due), so nothing overlaps the
+  // preparation: it goes to the mapping thread too, and pre-mapping goes on at once.
   for (size_t i = 0; i < pending.size(); ++i) mapper.add_frame(std::move(pending[i]), pending_keyframe[i]);
   pending.clear();
   pending_keyframe.clear();
   const MappingContext ctx = mapping_context();
-  std::shared_ptr<GaussianMapper::Prepared> prepared = mapper.prepare(ctx);
+  const bool prepare_here = config.schedule() != MappingSchedule::Live;
+  std::shared_ptr<GaussianMapper::Prepared> prepared = prepare_here ? mapper.prepare(ctx) : nullptr;
   std::exception_ptr failed;  // of the running step: reported after this one starts (its frames are consumed)
   bool waited = false;
   try {
@@ -311,6 +320,7 @@ void Session::Impl::schedule_mapping(FrameReport& report) {
     ++mapping.waits;
   }
   auto job = [this, ctx, prepared = std::move(prepared)]() mutable {
+    if (!prepared) prepared = mapper.prepare(ctx);  // live
     const MappingStats s = mapper.run(std::move(prepared), ctx);
     std::lock_guard lock(state_mutex);
     ++mapping.steps;
