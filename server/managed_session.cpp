@@ -1,6 +1,7 @@
 #include "server/managed_session.h"
 
 #include "client/lib/proto_convert.h"
+#include "core/slam/mapping_schedule.h"
 #include "server/status_error.h"
 #include "server/view_encode.h"
 
@@ -250,6 +251,7 @@ v1::SessionInfo ManagedSession::info() const {
   i.set_queue_capacity(uint32_t(meta_.queue_capacity));
   i.set_idle_seconds(idle_seconds());
   i.set_device(session_->config().device.to_string());
+  i.set_schedule(to_string(session_->config().schedule()));
   return i;
 }
 

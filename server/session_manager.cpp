@@ -43,10 +43,14 @@ void check_override_key(const std::string& key) {
 }
 
 SessionConfig make_config(const v1::CreateSessionRequest& r, const ManagerOptions& o) {
-  SessionConfig c;
+  SessionConfig c = o.defaults;
   c.K = service::from_proto(r.intrinsics());
   c.device = o.device;
   c.remote_address = o.segmenter_address;
+  // A client that names the schedule (sync or live, either value) chooses it: the server's default
+  // schedule is dropped first, so `sync=true` on a server that defaults to live runs sync.
+  for (const auto& [key, value] : r.config())
+    if (key == "sync" || key == "live") c.sync = c.live = false;
   for (const auto& [key, value] : r.config()) {
     check_override_key(key);
     try {
@@ -67,6 +71,49 @@ SessionConfig make_config(const v1::CreateSessionRequest& r, const ManagerOption
 }
 
 }  // namespace
+
+SessionConfig make_server_defaults(const std::filesystem::path& yaml, const std::vector<std::string>& assignments) {
+  SessionConfig c;
+  const SessionConfig plain;
+  if (!yaml.empty()) {
+    try {
+      load_config_yaml(c, yaml);
+    } catch (const std::exception& e) {
+      throw std::invalid_argument(std::string("--config: ") + e.what());
+    }
+  }
+  const auto server_owned = [](const std::string& key) {
+    if (key.rfind("camera.", 0) == 0)
+      throw std::invalid_argument("--set " + key + ": each session's camera comes from its Create request's intrinsics");
+    if (key == "device" || key == "remote_address")
+      throw std::invalid_argument("--set " + key + ": set by rrg serve's " +
+                                  std::string(key == "device" ? "--device" : "--segmenter"));
+  };
+  for (const std::string& a : assignments) {
+    const auto eq = a.find('=');
+    if (eq == std::string::npos || eq == 0) throw std::invalid_argument("--set '" + a + "': not key=value");
+    server_owned(a.substr(0, eq));
+    try {
+      apply_override(c, a);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument("--set " + a + ": " + e.what());
+    }
+  }
+  if (!yaml.empty() && (c.K.fx != plain.K.fx || c.K.fy != plain.K.fy || c.K.cx != plain.K.cx || c.K.cy != plain.K.cy ||
+                        c.K.width != plain.K.width || c.K.height != plain.K.height))
+    throw std::invalid_argument("--config " + yaml.string() + ": camera: each session's camera comes from its Create request's intrinsics");
+  if (!yaml.empty() && (c.device != plain.device || c.remote_address != plain.remote_address))
+    throw std::invalid_argument("--config " + yaml.string() + ": device and remote_address are set by rrg serve's --device and --segmenter");
+  SessionConfig check = c;  // validated as a session's config, with a stand-in camera
+  check.K = Intrinsics{525.0f, 525.0f, 319.5f, 239.5f, 640, 480};
+  if (check.semantics == "remote") check.remote_address = "stand-in";  // the server checks --segmenter per Create
+  try {
+    check.validate();
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("session defaults (--config / --set): ") + e.what());
+  }
+  return c;
+}
 
 SessionManager::SessionManager(ManagerOptions options, Metrics& metrics) : options_(std::move(options)), metrics_(metrics) {
   if (!options_.snapshot_dir.empty()) fs::create_directories(options_.snapshot_dir);

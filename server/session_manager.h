@@ -6,6 +6,7 @@
 // snapshot of every session at shutdown, and draining (issue #11): refuse new sessions, snapshot
 // and free every session, and remember which were drained so later calls say where they went.
 #include "core/common/device.h"
+#include "core/slam/session_config.h"
 #include "rrg/v1/service.pb.h"
 #include "server/managed_session.h"
 #include "server/metrics.h"
@@ -37,7 +38,17 @@ struct ManagerOptions {
   std::string admin_key;             // empty = no admin key
   std::string segmenter_address;     // for sessions whose config asks for semantics = remote
   std::string server_name = "rrg";   // named in errors and sent as x-rrg-server (rrg serve --name)
+  // Every session's base config (rrg serve --config / --set); a Create's overrides apply on top,
+  // and a Create naming `sync` or `live` chooses the schedule itself (make_server_defaults).
+  SessionConfig defaults;
 };
+
+// The base config of the server's sessions: the YAML file (when given), then the key=value
+// assignments, as `rrg run` reads them. The camera (each Create's intrinsics), the device
+// (--device) and the segmenter (--segmenter) are the server's own and refused here; the rest is
+// validated as a session's would be (with a stand-in camera). std::invalid_argument naming the
+// key or the file otherwise.
+SessionConfig make_server_defaults(const std::filesystem::path& yaml, const std::vector<std::string>& assignments);
 
 class SessionManager {
  public:

@@ -46,6 +46,12 @@ void register_serve_command(CLI::App& app) {
   cmd->add_option("--http-port-file", o->http_port_file, "write the bound HTTP port to this file once serving");
   cmd->add_option("--viewer-dir", o->viewer_dir, "the built viewer (default: web_viewer/dist of the source tree, if built)");
   cmd->add_flag("--log-json", *log_json, "one JSON object per log line (time, level, message)");
+  auto config = std::make_shared<std::string>();
+  auto sets = std::make_shared<std::vector<std::string>>();
+  cmd->add_option("--config", *config, "YAML file of session defaults (as rrg run --config); Create overrides apply on top")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--set", *sets, "session default key=value (repeatable), e.g. live=true on a CPU server; "
+                                  "a Create naming sync or live chooses the schedule itself");
   cmd->callback([=] {
     if (*log_json) spdlog::set_pattern(R"({"time":"%Y-%m-%dT%H:%M:%S.%f%z","level":"%l","thread":%t,"msg":"%v"})");
     server::ServerOptions opts = *o;
@@ -55,6 +61,7 @@ void register_serve_command(CLI::App& app) {
       opts.manager.server_name = ::gethostname(host, sizeof(host) - 1) == 0 && host[0] != '\0' ? host : "rrg";
     }
     opts.manager.device = parse_device(*device);
+    opts.manager.defaults = server::make_server_defaults(*config, *sets);  // refused before anything binds
     opts.manager.max_sessions = *max_sessions;
     opts.manager.default_queue = *queue;
     opts.manager.session_memory_budget = size_t(*session_mb * 1024.0 * 1024.0);

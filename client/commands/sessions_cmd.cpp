@@ -30,12 +30,12 @@ void register_session_commands(CLI::App& app) {
     cmd->add_option("--admin-key", *admin, "the server's admin key (default: $RRG_ADMIN_KEY)");
     cmd->callback([=] {
       const auto list = f->client().list(admin_key_or_env(*admin));
-      std::printf("%-18s %-20s %8s %8s %8s %10s %10s %12s %8s\n", "session", "name", "frames", "dropped", "state",
-                  "map", "gaussians", "memory MiB", "idle s");
+      std::printf("%-18s %-20s %8s %8s %8s %-10s %10s %10s %12s %8s\n", "session", "name", "frames", "dropped", "state",
+                  "schedule", "map", "gaussians", "memory MiB", "idle s");
       for (const auto& s : list.sessions())
-        std::printf("%-18s %-20s %8llu %8llu %8s %10llu %10llu %12.1f %8.1f\n", s.session_id().c_str(),
+        std::printf("%-18s %-20s %8llu %8llu %8s %-10s %10llu %10llu %12.1f %8.1f\n", s.session_id().c_str(),
                     s.name().substr(0, 20).c_str(), (unsigned long long)s.frames(),
-                    (unsigned long long)s.frames_dropped(), service::to_string(s.state()).c_str(),
+                    (unsigned long long)s.frames_dropped(), service::to_string(s.state()).c_str(), s.schedule().c_str(),
                     (unsigned long long)s.map_version(),
                     (unsigned long long)(s.base_gaussians() + s.reflection_gaussians()),
                     double(s.device_bytes() + s.host_bytes()) / (1024.0 * 1024.0), s.idle_seconds());

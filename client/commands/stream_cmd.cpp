@@ -138,8 +138,8 @@ void run_stream(const StreamCmdOptions& o) {
     client.set_server_observer([&](const std::string&, const std::string&, const std::string& name) { server = name; });
     const auto r = create_with_retries(client, create, o, server);
     runs[k].handle = {r.session_id(), r.token()};
-    spdlog::info("stream: session {} on server {} via {} ({})", r.session_id(), server.empty() ? "?" : server,
-                 o.service.server, r.info().device());
+    spdlog::info("stream: session {} on server {} via {} ({}, {} mapping)", r.session_id(), server.empty() ? "?" : server,
+                 o.service.server, r.info().device(), r.info().schedule());
   }
   client.set_server_observer(nullptr);
   std::mutex print_mutex;

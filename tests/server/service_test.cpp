@@ -63,6 +63,53 @@ TEST(Service, StreamGivesTheInProcessSessionsTrajectory) {
 // A sensor that loses the mirror's depth: the session fills it from the wall around the mirror
 // (labels sent with the frames) and each FrameResult says how many pixels, and how many it kept
 // out of ORB, as the in-process Session does on the same frames.
+// rrg serve --set: every session's base config, under each Create's overrides; a Create naming sync
+// or live chooses the schedule itself. Bad defaults stop the server before it binds, naming the key.
+TEST(Service, ServerDefaultsApplyUnderEachCreatesOverrides) {
+  ServerProcess server({"--set", "live=true", "--set", "mapping.iterations=2"});
+  auto c = server.client();
+  const auto schedule_of = [&](const std::map<std::string, std::string>& edits, const std::vector<std::string>& drop) {
+    v1::CreateSessionRequest r = create_request();  // sync=true among its overrides
+    for (const std::string& k : drop) r.mutable_config()->erase(k);
+    for (const auto& [k, v] : edits) (*r.mutable_config())[k] = v;
+    const auto created = c.create(r);
+    return std::pair{SessionHandle{created.session_id(), created.token()}, created.info().schedule()};
+  };
+  const auto [live, live_schedule] = schedule_of({}, {"sync"});
+  EXPECT_EQ(live_schedule, "live");  // the server's default
+  EXPECT_EQ(schedule_of({}, {}).second, "sync");  // the client's sync=true replaces it
+  EXPECT_EQ(schedule_of({{"live", "false"}}, {"sync"}).second, "overlapped");
+  {  // a server without defaults
+    auto plain = shared_server().client();
+    v1::CreateSessionRequest r = create_request();
+    r.mutable_config()->erase("sync");
+    const auto created = plain.create(r);
+    EXPECT_EQ(created.info().schedule(), "overlapped");
+    plain.close({created.session_id(), created.token()});
+  }
+  // The live session maps and answers every frame.
+  const auto results = stream_frames(c, live, 0, wire_frames().size());
+  ASSERT_EQ(results.size(), wire_frames().size());
+  for (const auto& r : results) EXPECT_FALSE(r.has_error() || r.dropped()) << r.id();
+  const v1::SessionInfo info = c.get(live);
+  EXPECT_EQ(info.frames(), wire_frames().size());
+  EXPECT_EQ(info.schedule(), "live");
+  EXPECT_GE(info.mapping_steps(), 1u);
+
+  const auto refused = [](const std::string& args, const std::string& mention) {
+    const auto [rc, out] = run_shell("timeout 60 " + rrg_executable().string() +
+                                     " serve --address 127.0.0.1:0 --device cpu " + args + " 2>&1");
+    EXPECT_NE(rc, 0) << args;
+    EXPECT_NE(rc, 124) << args << ": it served";
+    EXPECT_NE(out.find(mention), std::string::npos) << args << ": " << out;
+  };
+  refused("--set camera.fx=500", "camera.fx");
+  refused("--set device=cuda", "--device");
+  refused("--set tsdf.voxel_sise=0.01", "tsdf.voxel_sise");
+  refused("--set tsdf.voxel_size=-1", "voxel");
+  refused("--set sync=true --set live=true", "choose one");
+}
+
 TEST(Service, FramesReportTheDepthFilledOnALostMirror) {
   TempDir dir("rrg-lost-mirror");
   const auto synth = run_rrg("synth --preset mirror_room --frames 6 --width 160 --height 120 --novel 0 --threads 2 "
