@@ -21,7 +21,9 @@
 
 #include <algorithm>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
+#include <type_traits>
 #include <vector>
 
 namespace rrg::kernel {
@@ -293,16 +295,24 @@ void refl_fwd_cpu(ReflFwdArgs a, CpuRasterScratch& scratch) {
         alive[l] = refl_pixel_active(a.mode, a.plane, I[l]);
         live += alive[l] ? 1 : 0;
       }
-    const auto splat_fwd = [&](int32_t, int32_t g, const Splat& s, const PixelRect& p) {
-      for (int y = p.y0; y < p.y1; ++y)
-        for (int x = p.x0; x < p.x1; ++x) {
-          const int l = tp.local(x, y);
-          if (!alive[l] || (a.mode == PlaneMode::Match && a.plane_ids[g] != I[l])) continue;  // 1(l_i == I(u))
-          if (!refl_step(st[l], s, float(x), float(y)) || refl_mean_above(st[l], a.stop_mean))  // early termination
-            alive[l] = false, --live;
-        }
+    // The mean test only where it can stop a pixel (the tracking mask's threshold; the mapper's
+    // renders pass +inf): a visit's cost is a few dozen flops, and the test on the colour just
+    // composited sat on its critical path. NaN never stops, as in refl_mean_above.
+    const auto composite = [&](auto can_stop) {
+      const auto splat_fwd = [&](int32_t, int32_t g, const Splat& s, const PixelRect& p) {
+        for (int y = p.y0; y < p.y1; ++y)
+          for (int x = p.x0; x < p.x1; ++x) {
+            const int l = tp.local(x, y);
+            if (!alive[l] || (a.mode == PlaneMode::Match && a.plane_ids[g] != I[l])) continue;  // 1(l_i == I(u))
+            bool done = !refl_step(st[l], s, float(x), float(y));  // early termination
+            if constexpr (decltype(can_stop)::value) done = done || refl_mean_above(st[l], a.stop_mean);
+            if (done) alive[l] = false, --live;
+          }
+      };
+      for_each_reaching_splat(a.bins, a.splats, scratch.reach, tile, tp, [&] { return live > 0; }, splat_fwd);
     };
-    for_each_reaching_splat(a.bins, a.splats, scratch.reach, tile, tp, [&] { return live > 0; }, splat_fwd);
+    if (a.stop_mean < std::numeric_limits<float>::infinity()) composite(std::true_type{});
+    else composite(std::false_type{});
     for (int y = tp.y0; y < tp.y1; ++y)
       for (int x = tp.x0; x < tp.x1; ++x) {
         const int l = tp.local(x, y);
