@@ -153,8 +153,9 @@ T ssim(Backend be, int w, int h, Span<const T> x, Span<const T> y, Span<T> v_x, 
 // L_grad = ‖Sobel(C_r)‖₁ = mean over interior pixels (1 ≤ x ≤ W−2, 1 ≤ y ≤ H−2) and channels of
 // |Gx| + |Gy|. Gradient gathered per pixel q from the 3×3 interior neighbours p:
 // Σ_p sign(Gx(p)) kx(q − p) + sign(Gy(p)) ky(q − p).
+// sobel_l1_loss one element at a time (CUDA: one thread each); the CPU runs sobel_l1_loss_rows.
 template <class Backend, class T>
-T sobel_l1_loss(Backend be, int w, int h, Span<const T> x, Span<T> v_x, T weight, Span<int8_t> signs) {
+T sobel_l1_loss_elements(Backend be, int w, int h, Span<const T> x, Span<T> v_x, T weight, Span<int8_t> signs) {
   if (w < 3 || h < 3) return T(0);
   const T count = T(int64_t(w - 2) * (h - 2) * 3);
   const T* img = x.data;
@@ -194,6 +195,83 @@ T sobel_l1_loss(Backend be, int w, int h, Span<const T> x, Span<T> v_x, T weight
     });
   }
   return total / count;
+}
+
+// The same loss on the CPU, a row at a time: each row's responses and signs are computed with
+// whole-row pointer arithmetic (no per-element index division), into `values` (the per-element
+// |Gx| + |Gy|, 0 off the interior), whose sum is then reduced as sobel_l1_loss_elements reduces
+// (the same chunks in the same order); the gradient gathers each row's nine offsets in the same
+// (dy, dx) order. So both give the same floats (Losses.SobelRowsEqualThePerElementSums).
+template <class T>
+T sobel_l1_loss_rows(int w, int h, Span<const T> x, Span<T> v_x, T weight, Span<int8_t> signs, Span<T> values) {
+  if (w < 3 || h < 3) return T(0);
+  const T count = T(int64_t(w - 2) * (h - 2) * 3);
+  const int64_t row = int64_t(w) * 3, n = row * h;
+  const bool grad = !v_x.empty();
+  const T* img = x.data;
+  T* val = values.data;
+  int8_t* sx = signs.data;  // here sign(Gx) of every element, then sign(Gy) (planar: vector loads)
+  int8_t* sy = signs.data + (grad ? n : 0);
+  parallel_for(CpuBackend{}, h, [=](int64_t y) {
+    T* out = val + y * row;
+    if (y < 1 || y > h - 2) {
+      std::fill(out, out + row, T(0));
+      return;
+    }
+    const T *up = img + (y - 1) * row, *mid = img + y * row, *dn = img + (y + 1) * row;
+    const auto gx = [=](int64_t e) {  // as sobel_at, term by term
+      return (up[e + 3] + T(2) * mid[e + 3] + dn[e + 3]) - (up[e - 3] + T(2) * mid[e - 3] + dn[e - 3]);
+    };
+    const auto gy = [=](int64_t e) { return (dn[e - 3] + T(2) * dn[e] + dn[e + 3]) - (up[e - 3] + T(2) * up[e] + up[e + 3]); };
+    std::fill(out, out + 3, T(0));
+    std::fill(out + row - 3, out + row, T(0));
+    for (int64_t e = 3; e < row - 3; ++e) out[e] = abs_of(gx(e)) + abs_of(gy(e));
+    if (!grad) return;
+    // Local pointers: the byte stores could alias the closure's captures, which the compiler would
+    // then reload every element. (a > 0) − (a < 0) is sign_of(a) (0 for NaN too), branch-free.
+    int8_t* const ox = sx + y * row;
+    int8_t* const oy = sy + y * row;
+    for (int64_t e = 3; e < row - 3; ++e) {
+      const T a = gx(e), b = gy(e);
+      ox[e] = int8_t(int(a > T(0)) - int(a < T(0)));
+      oy[e] = int8_t(int(b > T(0)) - int(b < T(0)));
+    }
+  });
+  const T total = parallel_reduce(
+      CpuBackend{}, n, T(0), [=](int64_t i) { return val[i]; }, [](T a, T b) { return a + b; });
+  if (grad) {
+    const T s = weight / count;
+    T* v = v_x.data;
+    parallel_for(CpuBackend{}, h, [=](int64_t qy) {
+      T g[1024 * 3];  // a row's sums, in pieces of 1024 pixels
+      for (int64_t e0 = 0; e0 < row; e0 += 1024 * 3) {
+        const int64_t e1 = std::min(row, e0 + int64_t(1024) * 3);
+        std::fill(g, g + (e1 - e0), T(0));
+        for (int dy = -1; dy <= 1; ++dy) {
+          const int64_t py = qy - dy;
+          if (py < 1 || py > h - 2) continue;
+          for (int dx = -1; dx <= 1; ++dx) {
+            // p = q − (dx, dy) interior: 1 ≤ qx − dx ≤ w − 2
+            const int64_t lo = std::max(e0, int64_t(1 + dx) * 3), hi = std::min(e1, int64_t(w - 1 + dx) * 3);
+            const T kx = T(sobel_kx(dx, dy)), ky = T(sobel_ky(dx, dy));
+            const int64_t p0 = py * row - int64_t(dx) * 3;  // element of p for element e of q: p0 + e
+            const int8_t *px = sx + p0, *pyy = sy + p0;
+            for (int64_t e = lo; e < hi; ++e) g[e - e0] += T(px[e]) * kx + T(pyy[e]) * ky;
+          }
+        }
+        T* vq = v + qy * row;
+        for (int64_t e = e0; e < e1; ++e) vq[e] += s * g[e - e0];
+      }
+    });
+  }
+  return total / count;
+}
+
+template <class Backend, class T>
+T sobel_l1_loss(Backend be, int w, int h, Span<const T> x, Span<T> v_x, T weight, Span<int8_t> signs,
+                Span<T> values = {}) {
+  if constexpr (std::is_same_v<Backend, CpuBackend>) return sobel_l1_loss_rows(w, h, x, v_x, weight, signs, values);
+  else return sobel_l1_loss_elements(be, w, h, x, v_x, weight, signs);
 }
 
 // Entry points of each back end (T = float everywhere; T = double on the CPU for the tests).

@@ -132,6 +132,31 @@ TEST(Losses, SsimRowPassesEqualThePerElementTapSums) {
   }
 }
 
+// The CPU computes the Sobel term a row at a time (sobel_l1_loss_rows), CUDA one element at a time
+// (sobel_l1_loss_elements): the same floats, value and gradient, borders and tiny images included.
+TEST(Losses, SobelRowsEqualThePerElementSums) {
+  for (auto [w, h] : {std::pair{37, 23}, std::pair{3, 3}, std::pair{4, 9}, std::pair{1100, 5}, std::pair{2, 7}}) {
+    SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h));
+    const size_t n = size_t(w) * h * 3;
+    std::vector<float> x(n), g_rows(n, 0.5f), g_elems(n, 0.5f), values(n);
+    std::mt19937 rng(w * 31 + h);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    for (float& v : x) v = u(rng);
+    for (size_t i = 0; i < n; i += 7) x[i] = x[i > 3 ? i - 3 : i];  // some responses exactly 0 (sign 0)
+    std::vector<int8_t> s_rows(2 * n, 9), s_elems(2 * n, 9);
+    const Span<const float> xs{x.data(), int64_t(n)};
+    const float a = kernel::sobel_l1_loss_rows<float>(w, h, xs, {g_rows.data(), int64_t(n)}, 0.3f,
+                                                      {s_rows.data(), int64_t(2 * n)}, {values.data(), int64_t(n)});
+    const float b = kernel::sobel_l1_loss_elements<CpuBackend, float>(
+        CpuBackend{}, w, h, xs, {g_elems.data(), int64_t(n)}, 0.3f, {s_elems.data(), int64_t(2 * n)});
+    EXPECT_EQ(a, b);
+    int64_t differ = 0;
+    for (size_t i = 0; i < n; ++i) differ += g_rows[i] == g_elems[i] ? 0 : 1;
+    EXPECT_EQ(differ, 0);
+    if (w >= 3 && h >= 3) EXPECT_GT(a, 0.0f);
+  }
+}
+
 TEST(Losses, SsimRefusesAScratchTooSmall) {
   std::vector<double> x = random_image(W, H, 3, 5), y = random_image(W, H, 3, 6), none;
   std::vector<double> scratch(size_t(W) * H * kernel::kSsimScratch - 1);
