@@ -1,7 +1,10 @@
 #include "core/common/parallel_for.h"
 #include "core/gaussians/losses_impl.h"
+#include "core/gaussians/ssim_rows_cpu.h"
 
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace rrg::kernel {
@@ -14,9 +17,17 @@ template <class T>
 T depth_l1_loss_cpu(Span<const T> d, Span<const T> d_gt, Span<T> v_d, T weight) {
   return depth_l1_loss(CpuBackend{}, d, d_gt, v_d, weight);
 }
+// Streamed over rows (ssim_rows_cpu.h; the same floats as the separate passes) whenever its bands
+// fit the scratch ssim() asks for, which is all but images a few rows tall.
 template <class T>
 T ssim_cpu(int w, int h, Span<const T> x, Span<const T> y, Span<T> v_x, T weight, SsimWindow<T> win,
            Span<T> scratch) {
+  const int64_t need = int64_t(w) * h * kSsimScratch;
+  if (scratch.size < need)
+    throw std::invalid_argument("ssim: the scratch holds " + std::to_string(scratch.size) + " scalars, " +
+                                std::to_string(need) + " needed");
+  if (w > 0 && h > 0 && ssim_rows_scratch(w, h, ssim_rows_bands(h)) <= need)
+    return ssim_rows(w, h, x, y, v_x, weight, win, scratch);
   return ssim(CpuBackend{}, w, h, x, y, v_x, weight, win, scratch);
 }
 template <class T>

@@ -2,6 +2,7 @@
 // (the same kernels instantiated in double), float-vs-double agreement and CPU/CUDA parity.
 #include "core/gaussians/losses.h"
 #include "core/gaussians/losses_impl.h"
+#include "core/gaussians/ssim_rows_cpu.h"
 #include "tests/support/parity.h"
 
 #include <gtest/gtest.h>
@@ -154,6 +155,41 @@ TEST(Losses, SobelRowsEqualThePerElementSums) {
     for (size_t i = 0; i < n; ++i) differ += g_rows[i] == g_elems[i] ? 0 : 1;
     EXPECT_EQ(differ, 0);
     if (w >= 3 && h >= 3) EXPECT_GT(a, 0.0f);
+  }
+}
+
+// The CPU's SSIM streams rows through rings (ssim_rows) instead of whole intermediate images: the
+// same floats as the separate passes, value and gradient, at sizes from under one window to several
+// bands (the bands recompute their neighbours' halo rows), with and without the gradient.
+TEST(Losses, SsimRowsEqualTheSeparatePasses) {
+  for (auto [w, h] : {std::pair{37, 23}, std::pair{8, 5}, std::pair{300, 97}, std::pair{5, 140}}) {
+    SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h));
+    const size_t n = size_t(w) * h * 3;
+    std::vector<float> x(n), y(n), g_rows(n, 0.25f), g_sep(n, 0.25f);
+    std::mt19937 rng(w + 1000 * h);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    for (size_t i = 0; i < n; ++i) x[i] = u(rng), y[i] = 0.5f * x[i] + 0.5f * u(rng);
+    std::vector<float> scratch(size_t(w) * h * kernel::kSsimScratch);
+    const Span<float> sc{scratch.data(), int64_t(scratch.size())};
+    const Span<const float> xs{x.data(), int64_t(n)}, ys{y.data(), int64_t(n)};
+    kernel::SsimWindow<float> win{};
+    double total = 0;
+    for (int k = 0; k <= 2 * kernel::kSsimRadius; ++k) total += std::exp(-(k - 5) * (k - 5) / 4.5);
+    for (int k = 0; k <= 2 * kernel::kSsimRadius; ++k) win.g[k] = float(std::exp(-(k - 5) * (k - 5) / 4.5) / total);
+    win.c1 = 1e-4f, win.c2 = 9e-4f;
+    ASSERT_LE(kernel::ssim_rows_scratch(w, h, kernel::ssim_rows_bands(h)), int64_t(scratch.size()));
+    for (const bool grad : {false, true}) {
+      const Span<float> g_r = grad ? Span<float>{g_rows.data(), int64_t(n)} : Span<float>{};
+      const Span<float> g_s = grad ? Span<float>{g_sep.data(), int64_t(n)} : Span<float>{};
+      const float a = kernel::ssim_rows<float>(w, h, xs, ys, g_r, -0.2f, win, sc);
+      const float b = kernel::ssim<CpuBackend, float>(CpuBackend{}, w, h, xs, ys, g_s, -0.2f, win, sc);
+      EXPECT_EQ(a, b) << (grad ? "with" : "without") << " the gradient";
+      EXPECT_GT(a, 0.0f);
+    }
+    int64_t differ = 0;
+    for (size_t i = 0; i < n; ++i) differ += g_rows[i] == g_sep[i] ? 0 : 1;
+    EXPECT_EQ(differ, 0);
+    EXPECT_NE(g_rows[n / 2], 0.25f);  // the gradient was added
   }
 }
 
