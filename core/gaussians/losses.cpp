@@ -100,14 +100,18 @@ float depth_l1_loss(const DeviceImage<float>& d, const DeviceImage<float>& d_gt,
   return r;
 }
 
-float sobel_l1_loss(const DeviceImage<Color>& x, DeviceImage<Color>* v_x, float weight, Buffer<int8_t>& scratch) {
+float sobel_l1_loss(const DeviceImage<Color>& x, DeviceImage<Color>* v_x, float weight, Buffer<int8_t>& scratch,
+                    Buffer<float>& values) {
   if (v_x) check_same(x, *v_x, "sobel_l1_loss (gradient)");
   const size_t need = v_x ? size_t(x.width()) * size_t(x.height()) * 6 : 0;
   if (scratch.size() < need || (need > 0 && scratch.device() != x.device())) scratch = Buffer<int8_t>(need, x.device());
   const Span<int8_t> signs{scratch.data(), int64_t(need)};
+  const size_t n = x.device().is_cpu() ? size_t(x.width()) * size_t(x.height()) * 3 : 0;
+  if (values.size() < n || (n > 0 && values.device() != x.device())) values = Buffer<float>(n, x.device());
   float r = 0;
   RRG_DISPATCH(x.device(),
-               r = kernel::sobel_l1_loss_cpu<float>(x.width(), x.height(), flat(x), flat_grad(v_x), weight, signs),
+               r = kernel::sobel_l1_loss_cpu<float>(x.width(), x.height(), flat(x), flat_grad(v_x), weight, signs,
+                                                    values.span()),
                r = kernel::sobel_l1_loss_cuda(x.width(), x.height(), flat(x), flat_grad(v_x), weight, signs));
   return r;
 }
@@ -127,7 +131,7 @@ LossValues mapping_loss(const DeviceImage<Color>& C, const DeviceImage<Color>& C
   L.depth_l1 = depth_l1_loss(D_b, D_gt, &v_D_b, w.lambda_depth);
   if (C_r && w.lambda_sobel > 0.0f) {
     zero_like(v_C_r, C.width(), C.height(), dev);
-    L.sobel = sobel_l1_loss(*C_r, &v_C_r, w.lambda_sobel, scratch.sobel);
+    L.sobel = sobel_l1_loss(*C_r, &v_C_r, w.lambda_sobel, scratch.sobel, scratch.sobel_values);
   } else {
     v_C_r = DeviceImage<Color>();
   }

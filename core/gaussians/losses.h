@@ -31,13 +31,16 @@ float ssim(const DeviceImage<Color>& x, const DeviceImage<Color>& y, DeviceImage
 float depth_l1_loss(const DeviceImage<float>& d, const DeviceImage<float>& d_gt, DeviceImage<float>* v_d,
                     float weight);
 // mean (|Gx| + |Gy|) of the Sobel responses over interior pixels; v_x += weight ∂/∂x. scratch (the
-// responses' signs, for the gradient) is resized as needed.
-float sobel_l1_loss(const DeviceImage<Color>& x, DeviceImage<Color>* v_x, float weight, Buffer<int8_t>& scratch);
+// responses' signs, for the gradient) is resized as needed; so is `values` on the CPU (each
+// element's response, which the CPU's row pass reduces; kernel::sobel_l1_loss_rows).
+float sobel_l1_loss(const DeviceImage<Color>& x, DeviceImage<Color>* v_x, float weight, Buffer<int8_t>& scratch,
+                    Buffer<float>& values);
 
 // Working memory of mapping_loss, kept by the caller between calls.
 struct LossScratch {
   Buffer<float> ssim;
   Buffer<int8_t> sobel;
+  Buffer<float> sobel_values;  // CPU only
 };
 
 // The whole mapping loss. Overwrites v_C, v_D_b (and v_C_r when C_r is given and λ_g > 0; else it

@@ -31,19 +31,21 @@ T ssim_cpu(int w, int h, Span<const T> x, Span<const T> y, Span<T> v_x, T weight
   return ssim(CpuBackend{}, w, h, x, y, v_x, weight, win, scratch);
 }
 template <class T>
-T sobel_l1_loss_cpu(int w, int h, Span<const T> x, Span<T> v_x, T weight, Span<int8_t> signs) {
-  // The per-element responses the sum is reduced from, kept by each calling thread between calls
-  // (one image's worth: 0.9 MB at 320x240), so that no call faults a new buffer in.
-  thread_local std::vector<T> values;
-  values.resize(size_t(std::max(w, 0)) * size_t(std::max(h, 0)) * 3);
-  return sobel_l1_loss(CpuBackend{}, w, h, x, v_x, weight, signs, Span<T>{values.data(), int64_t(values.size())});
+T sobel_l1_loss_cpu(int w, int h, Span<const T> x, Span<T> v_x, T weight, Span<int8_t> signs, Span<T> values) {
+  const int64_t n = int64_t(std::max(w, 0)) * std::max(h, 0) * 3;
+  std::vector<T> own;  // for callers without working memory (tests)
+  if (values.size < n) {
+    own.resize(size_t(n));
+    values = {own.data(), n};
+  }
+  return sobel_l1_loss(CpuBackend{}, w, h, x, v_x, weight, signs, values);
 }
 
 #define RRG_LOSSES_INSTANTIATE(T)                                                                  \
   template T l1_loss_cpu<T>(Span<const T>, Span<const T>, Span<T>, T);                             \
   template T depth_l1_loss_cpu<T>(Span<const T>, Span<const T>, Span<T>, T);                       \
   template T ssim_cpu<T>(int, int, Span<const T>, Span<const T>, Span<T>, T, SsimWindow<T>, Span<T>); \
-  template T sobel_l1_loss_cpu<T>(int, int, Span<const T>, Span<T>, T, Span<int8_t>);
+  template T sobel_l1_loss_cpu<T>(int, int, Span<const T>, Span<T>, T, Span<int8_t>, Span<T>);
 RRG_LOSSES_INSTANTIATE(float)
 RRG_LOSSES_INSTANTIATE(double)
 #undef RRG_LOSSES_INSTANTIATE
