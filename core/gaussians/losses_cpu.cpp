@@ -38,7 +38,7 @@ T sobel_l1_loss_cpu(int w, int h, Span<const T> x, Span<T> v_x, T weight, Span<i
     own.resize(size_t(n));
     values = {own.data(), n};
   }
-  return sobel_l1_loss(CpuBackend{}, w, h, x, v_x, weight, signs, values);
+  return sobel_l1_loss_rows(w, h, x, v_x, weight, signs, values);
 }
 
 #define RRG_LOSSES_INSTANTIATE(T)                                                                  \

@@ -21,7 +21,7 @@ float ssim_cuda(int w, int h, Span<const float> x, Span<const float> y, Span<flo
   return r;
 }
 float sobel_l1_loss_cuda(int w, int h, Span<const float> x, Span<float> v_x, float weight, Span<int8_t> signs) {
-  const float r = sobel_l1_loss(CudaBackend{}, w, h, x, v_x, weight, signs);
+  const float r = sobel_l1_loss_elements(CudaBackend{}, w, h, x, v_x, weight, signs);
   RRG_CUDA_CHECK(cudaStreamSynchronize(nullptr));
   return r;
 }

@@ -153,7 +153,7 @@ T ssim(Backend be, int w, int h, Span<const T> x, Span<const T> y, Span<T> v_x, 
 // L_grad = ‖Sobel(C_r)‖₁ = mean over interior pixels (1 ≤ x ≤ W−2, 1 ≤ y ≤ H−2) and channels of
 // |Gx| + |Gy|. Gradient gathered per pixel q from the 3×3 interior neighbours p:
 // Σ_p sign(Gx(p)) kx(q − p) + sign(Gy(p)) ky(q − p).
-// sobel_l1_loss one element at a time (CUDA: one thread each); the CPU runs sobel_l1_loss_rows.
+// The Sobel term one element at a time (CUDA: one thread each); the CPU runs sobel_l1_loss_rows below.
 template <class Backend, class T>
 T sobel_l1_loss_elements(Backend be, int w, int h, Span<const T> x, Span<T> v_x, T weight, Span<int8_t> signs) {
   if (w < 3 || h < 3) return T(0);
@@ -207,6 +207,9 @@ T sobel_l1_loss_rows(int w, int h, Span<const T> x, Span<T> v_x, T weight, Span<
   if (w < 3 || h < 3) return T(0);
   const T count = T(int64_t(w - 2) * (h - 2) * 3);
   const int64_t row = int64_t(w) * 3, n = row * h;
+  if (values.size < n)
+    throw std::invalid_argument("sobel_l1_loss_rows: " + std::to_string(values.size) + " values of working memory, " +
+                                std::to_string(n) + " needed");
   const bool grad = !v_x.empty();
   const T* img = x.data;
   T* val = values.data;
@@ -265,13 +268,6 @@ T sobel_l1_loss_rows(int w, int h, Span<const T> x, Span<T> v_x, T weight, Span<
     });
   }
   return total / count;
-}
-
-template <class Backend, class T>
-T sobel_l1_loss(Backend be, int w, int h, Span<const T> x, Span<T> v_x, T weight, Span<int8_t> signs,
-                Span<T> values = {}) {
-  if constexpr (std::is_same_v<Backend, CpuBackend>) return sobel_l1_loss_rows(w, h, x, v_x, weight, signs, values);
-  else return sobel_l1_loss_elements(be, w, h, x, v_x, weight, signs);
 }
 
 // Entry points of each back end (T = float everywhere; T = double on the CPU for the tests).

@@ -170,6 +170,24 @@ TEST(RunCli, RateFeedsFramesNoFasterThanASensor) {
   EXPECT_FALSE(std::filesystem::exists(bad));
 }
 
+// `rrg run` of seq into dir/run in the background (CPU, 2 cm voxels, `flags`), Ctrl-C once it has
+// started: it exits with 128 + SIGINT and its metrics.json, returned, says it was interrupted.
+nlohmann::json interrupted_run(const test::TempDir& dir, const std::filesystem::path& seq, const std::string& flags) {
+  const auto out = dir / "run";
+  test::BackgroundRrg rrg("run --dataset " + seq.string() + " --out " + out.string() +
+                              " --device cpu --no-progress --set tsdf.voxel_size=0.02 --set tsdf.truncation=0.08 " + flags,
+                          dir / "log.txt");
+  // The run has started (and its handler is installed) once it logs its first line.
+  const bool started = rrg.wait_for_output("run: ");
+  EXPECT_TRUE(started) << "rrg run did not start";
+  if (!started) return nlohmann::json::object({{"interrupted", false}, {"frames", 0}});
+  rrg.signal(SIGINT);
+  EXPECT_EQ(rrg.wait(), 128 + SIGINT);
+  auto j = nlohmann::json::parse(std::ifstream(out / "metrics.json"));
+  EXPECT_TRUE(j.at("interrupted").get<bool>());
+  return j;
+}
+
 // Ctrl-C while --rate waits for the next frame (here 2000 s away): the wait ends at once, that frame
 // is processed and the run finishes as after any Ctrl-C. Without that, this test would sit out
 // CTest's 900 s timeout and fail.
@@ -177,16 +195,7 @@ TEST(RunCli, CtrlCEndsARateWait) {
   test::TempDir dir("run_cli_rate_stop");
   const auto seq = synth(dir, "office", 3, 0);
   ASSERT_FALSE(seq.empty());
-  const auto out = dir / "run";
-  test::BackgroundRrg rrg("run --dataset " + seq.string() + " --out " + out.string() +
-                              " --live --rate 0.0005 --device cpu --no-progress --set tsdf.voxel_size=0.02"
-                              " --set tsdf.truncation=0.08",
-                          dir / "log.txt");
-  ASSERT_TRUE(rrg.wait_for_output("run: ")) << "rrg run did not start";
-  rrg.signal(SIGINT);
-  EXPECT_EQ(rrg.wait(), 128 + SIGINT);
-  const auto j = nlohmann::json::parse(std::ifstream(out / "metrics.json"));
-  EXPECT_TRUE(j.at("interrupted").get<bool>());
+  const auto j = interrupted_run(dir, seq, "--live --rate 0.0005");
   EXPECT_LE(j.at("frames").get<size_t>(), 2u);  // frame 0, and at most the frame the stop let in
 }
 
@@ -197,16 +206,7 @@ TEST(RunCli, InterruptStopsAfterTheCurrentFrameAndWritesTheOutputs) {
   const auto seq = synth(dir, "living_room", 30, 0);
   ASSERT_FALSE(seq.empty());
   const auto out = dir / "run";
-  test::BackgroundRrg rrg("run --dataset " + seq.string() + " --out " + out.string() +
-                              " --device cpu --sync --no-progress --set tsdf.voxel_size=0.02 --set tsdf.truncation=0.08",
-                          dir / "log.txt");
-  // The run has started (and its handler is installed) once it logs its first line.
-  ASSERT_TRUE(rrg.wait_for_output("run: ")) << "rrg run did not start";
-  rrg.signal(SIGINT);
-  EXPECT_EQ(rrg.wait(), 128 + SIGINT);
-
-  const auto j = nlohmann::json::parse(std::ifstream(out / "metrics.json"));
-  EXPECT_TRUE(j.at("interrupted").get<bool>());
+  const auto j = interrupted_run(dir, seq, "--sync");
   const size_t frames = j.at("frames").get<size_t>();
   EXPECT_GE(frames, 1u);
   EXPECT_LT(frames, 30u);
