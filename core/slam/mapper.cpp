@@ -260,6 +260,7 @@ MappingStats GaussianMapper::step(const MappingContext& ctx) { return run(prepar
 
 MappingStats GaussianMapper::run(std::shared_ptr<Prepared> prepared, const MappingContext& ctx) {
   if (!prepared) throw std::invalid_argument("GaussianMapper::run: no prepared step");
+  if (ctx.iterations < 0) throw std::invalid_argument("GaussianMapper::run: the context asks for a negative number of iterations");
   std::lock_guard step_lock(step_mutex_);
   const auto t_start = Clock::now();
   MappingStats st;
@@ -366,7 +367,8 @@ MappingStats GaussianMapper::run(std::shared_ptr<Prepared> prepared, const Mappi
   const LossWeights lw = params_.loss_weights();
   RenderUpstream up;
   double loss_sum = 0;
-  for (int it = 0; it < params_.iterations; ++it) {
+  const int iterations = ctx.iterations > 0 ? ctx.iterations : params_.iterations;
+  for (int it = 0; it < iterations; ++it) {
     StepFrame& f = frames[order[size_t(it) % order.size()]];
     const bool pass3 = refl_.size() > 0 && f.shows_reflection;
     if (refl_.size() > 0 && !pass3) ++st.reflection_skipped;
@@ -387,9 +389,9 @@ MappingStats GaussianMapper::run(std::shared_ptr<Prepared> prepared, const Mappi
     if (pass3) adam_refl_.step(refl_, v_refl_);
     st.optimise.adam += ms_since(tp);
   }
-  st.iterations = params_.iterations;
+  st.iterations = iterations;
   st.frames = int(frames.size());
-  st.loss = params_.iterations > 0 ? loss_sum / params_.iterations : 0.0;
+  st.loss = iterations > 0 ? loss_sum / iterations : 0.0;
   st.ms_optimise = ms_since(t0);
 
   // 4. pruning

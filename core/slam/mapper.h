@@ -6,7 +6,7 @@
 //   2. densify base and reflection Gaussians on the N_local frames (core/gaussians/densify.h; with
 //      densify.reflection_stereo_depth the reflection candidates' depths come from a plane sweep
 //      against the step's other frames, core/slam/reflection_stereo.h);
-//   3. `iterations` = 30 Adam iterations, each on one of the selected frames (a seeded shuffle of
+//   3. `iterations` = 30 Adam iterations (or MappingContext::iterations), each on one of the selected frames (a seeded shuffle of
 //      the set, cycled): render C, D_b, C_r → L = (1−λ)L1 + λ(1−SSIM) + λ_d L1(D_b) + λ_g‖Sobel C_r‖₁
 //      → backward → Adam on the visible Gaussians of each set;
 //   4. prune both sets (core/gaussians/prune.h), Adam state compacted alongside;
@@ -109,6 +109,9 @@ struct MappingContext {
   // Plane id -> canonical id (GlobalPlaneTable::remap_table(), as the raycasts of this step used):
   // the step first moves reflection Gaussians of a merged-away plane to the id that absorbed it.
   std::vector<int32_t> remap;
+  // This step's Adam iterations; 0 = MapperParams::iterations (the live schedule scales them with
+  // the frames a step covers, core/slam/mapping_schedule.h).
+  int iterations = 0;
 };
 
 struct MappingStats {

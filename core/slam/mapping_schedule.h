@@ -11,6 +11,7 @@
 //               Overlapped schedule; where it does not (the CPU) tracking and fusion keep the
 //               stream's pace and the map gets fewer steps (docs/slam.md, "Schedule").
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -27,6 +28,18 @@ std::string to_string(MappingSchedule s);
 inline bool mapping_due(MappingSchedule s, int period, int64_t fused, size_t queued, bool running) {
   if (s == MappingSchedule::Live) return queued >= size_t(period) && !running;
   return fused % period == 0;
+}
+
+// Live: a step's Adam iterations. The paper runs `iterations` per N_o fused frames (30 per 10). A
+// live step that starts after `frames` fused frames since the one before (more than N_o where
+// mapping cannot keep up: the CPU) runs that rate over them, up to `max_scale` times `iterations`;
+// the bound keeps a step, and so the map's lag behind the camera, short. Where mapping keeps up
+// (frames = N_o), or with max_scale 1, every step runs `iterations`. A longer step also spends a
+// smaller share on its fixed part (the selected frames' pass-1 raycasts, densification): at 30
+// iterations on the 2-core CPU that part is a fifth of the step (docs/slam.md, "Schedule").
+inline int live_step_iterations(int iterations, int period, int64_t frames, double max_scale) {
+  const double scale = std::clamp(double(frames) / double(std::max(period, 1)), 1.0, std::max(max_scale, 1.0));
+  return int(std::lround(double(iterations) * scale));
 }
 
 // Live: the queue of frames waiting for the next step is bounded. A step uses of the frames since

@@ -276,6 +276,7 @@ RunResult run_dataset(const RunOptions& o) {
     *v *= per;
   t.premapping_ms = t.mean.raycast + t.mean.preprocess + t.mean.icp + t.mean.orb + t.mean.fuse + t.mean.identify;
   t.mapping_steps = st.mapping.steps;
+  t.mapping_iterations = st.mapping.iterations;
   t.mapping_waits = st.mapping.waits;
   const double per_step = st.mapping.steps ? 1.0 / double(st.mapping.steps) : 0.0;
   t.mapping_step_ms = st.mapping.ms_total * per_step;
@@ -442,6 +443,7 @@ std::string timings_json(const RunTimings& t, const std::string& device) {
   j["mapping_optimise_adam_per_step"] = t.mapping_optimise.adam;
   j["mapping_prune_per_step"] = t.mapping_prune_ms;
   j["mapping_steps"] = t.mapping_steps;
+  j["mapping_iterations"] = t.mapping_iterations;
   j["mapping_waits"] = t.mapping_waits;
   j["schedule"] = t.schedule;
   j["rate_hz"] = t.rate_hz;

@@ -86,6 +86,7 @@ struct RunTimings {
   double mapping_raycast_ms = 0, mapping_densify_ms = 0, mapping_optimise_ms = 0, mapping_prune_ms = 0;
   OptimiseTimes mapping_optimise;  // mapping_optimise_ms by part, per step
   int64_t mapping_steps = 0;
+  int64_t mapping_iterations = 0;  // Adam iterations over all steps (live: scaled per step)
   int64_t mapping_waits = 0;       // steps that waited for the one before (MappingSummary::waits)
   std::string schedule;            // sync, overlapped or live (mapping_schedule.h)
   double rate_hz = 0;              // RunOptions::rate_hz (0: frames fed as fast as they load)

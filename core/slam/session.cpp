@@ -305,7 +305,12 @@ void Session::Impl::schedule_mapping(FrameReport& report) {
   for (size_t i = 0; i < pending.size(); ++i) mapper.add_frame(std::move(pending[i]), pending_keyframe[i]);
   pending.clear();
   pending_keyframe.clear();
-  const MappingContext ctx = mapping_context();
+  MappingContext ctx = mapping_context();
+  // Live: the step's iterations follow the frames fused since the step before (mapping_schedule.h).
+  if (config.schedule() == MappingSchedule::Live)
+    ctx.iterations = live_step_iterations(config.mapping.iterations, config.mapping_period, fused - fused_at_step,
+                                          config.live_step_scale);
+  fused_at_step = fused;
   const bool prepare_here = config.schedule() != MappingSchedule::Live;
   std::shared_ptr<GaussianMapper::Prepared> prepared = prepare_here ? mapper.prepare(ctx) : nullptr;
   std::exception_ptr failed;  // of the running step: reported after this one starts (its frames are consumed)
@@ -324,6 +329,7 @@ void Session::Impl::schedule_mapping(FrameReport& report) {
     const MappingStats s = mapper.run(std::move(prepared), ctx);
     std::lock_guard lock(state_mutex);
     ++mapping.steps;
+    mapping.iterations += s.iterations;
     mapping.ms_total += s.ms_total;
     mapping.ms_raycast += s.ms_raycast;
     mapping.ms_densify += s.ms_densify;

@@ -89,6 +89,7 @@ struct SessionView {
 // Statistics of one mapping step, and their sums over a session.
 struct MappingSummary {
   int64_t steps = 0;
+  int64_t iterations = 0;          // Adam iterations, summed over steps (live: scaled per step)
   int64_t waits = 0;               // steps that waited for the one before to end (never with live)
   int64_t thinned = 0;             // live: queued frames dropped before reaching a step (thin_live_queue)
   int64_t queued = 0;              // fused frames waiting for the next step (after the last processed frame)

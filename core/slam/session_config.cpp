@@ -167,6 +167,8 @@ void SessionConfig::validate() const {
   if (plane_period < 1) throw std::invalid_argument("config plane_period: must be >= 1");
   if (mapping_period < 1) throw std::invalid_argument("config mapping_period: must be >= 1");
   if (final_steps < 0) throw std::invalid_argument("config final_steps: must be >= 0");
+  if (!(live_step_scale >= 1.0f && live_step_scale <= 100.0f))
+    throw std::invalid_argument("config live_step_scale: must be in [1, 100] (1: every live step runs mapping.iterations)");
   if (sync && live)
     throw std::invalid_argument("config sync and live: choose one (sync runs every step inline, live never waits for one)");
   if (semantics != "none" && semantics != "labels" && semantics != "remote")
@@ -192,6 +194,8 @@ std::vector<ConfigField> config_fields(SessionConfig& c) {
   t.i("final_steps", c.final_steps, "extra mapping steps over the keyframes at the end");
   t.b("sync", c.sync, "run mapping inline (deterministic) instead of on the mapping thread");
   t.b("live", c.live, "overlapped mapping that pre-mapping never waits for: a step starts once N_o frames are queued and none runs");
+  t.f("live_step_scale", c.live_step_scale,
+      "live: a step runs mapping.iterations per mapping_period frames it covers, at most this many times mapping.iterations");
   t.b("gt_poses", c.gt_poses, "use the frames' given poses (mapping only)");
   t.s("semantics", c.semantics, "semantic cue: none | labels | remote");
   t.s("remote_address", c.remote_address, "rrg.v1.Segmenter address (semantics = remote)");

@@ -32,6 +32,8 @@ struct SessionConfig {
   int final_steps = 0;                 // extra mapping steps over the keyframes at finish()
   bool sync = false;                   // run mapping steps inline (deterministic) instead of overlapped
   bool live = false;                   // overlapped without waiting for a running step (mapping_schedule.h)
+  float live_step_scale = 2.0f;        // live: a step's iterations follow the frames it covers, up to this
+                                       // many times mapping.iterations (live_step_iterations); 1 = always those
   bool gt_poses = false;               // take SessionFrame::pose as the pose (mapping only, no tracking)
   std::string semantics = "labels";    // semantic cue: none | labels | remote
   std::string remote_address;          // rrg.v1.Segmenter address for semantics = remote

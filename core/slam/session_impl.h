@@ -106,6 +106,7 @@ struct Session::Impl {
 
   // the schedule
   int64_t frames = 0, fused = 0, lost = 0, last_index = -1;
+  int64_t fused_at_step = 0;  // `fused` when the last mapping step was scheduled (live: the frames a step covers)
   std::vector<MappingFrame> pending;  // fused frames not yet handed to the mapper
   std::vector<bool> pending_keyframe;
 

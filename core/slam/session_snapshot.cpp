@@ -280,10 +280,13 @@ std::unique_ptr<Session> Session::load(const std::filesystem::path& file, std::u
       s.pending_keyframe.push_back(c.pending_keyframe[i] != 0);
     }
     s.mapping.queued = int64_t(s.pending.size());
+    // Not stored: the frames since the last step are the pending ones (live: fewer if thinned).
+    s.fused_at_step = s.fused - int64_t(s.pending.size());
     s.tracker_keyframes = s.tracker.keyframes().size();
     s.fill_regions = std::move(c.fill_regions);
     s.undecided = std::set<int>(c.undecided_planes.begin(), c.undecided_planes.end());
   } else {
+    s.fused_at_step = s.fused;
     spdlog::info("{}: format v1 has no keyframes, motion or optimiser state; tracking resumes from the last pose "
                  "and mapping from the frames that follow", what);
     if (s.frames > 0) s.tracker.resume(s.T_last);

@@ -136,6 +136,37 @@ TEST(Mapper, StepsAreDeterministicAndKeepTheBooks) {
   EXPECT_THROW(bad.validate(), std::invalid_argument);
 }
 
+// A step's context may set its iterations (the live schedule scales them, mapping_schedule.h): the
+// same map, bit for bit, as a mapper whose params give that number; 0 keeps the params'; a negative
+// number is refused before anything changes.
+TEST(Mapper, TheContextSetsAStepsIterations) {
+  const test::MapperScene s = small_scene();
+  MapperParams p = short_steps();
+  MapperParams q = p;
+  q.iterations = 9;
+  GaussianMapper a(p, s.K, Device::cpu()), b(q, s.K, Device::cpu());
+  MappingContext nine = s.context();
+  nine.iterations = 9;
+  for (size_t i = 0; i < 6; ++i) {
+    a.add_frame(s.frame(i), i % 4 == 0);
+    b.add_frame(s.frame(i), i % 4 == 0);
+  }
+  const MappingStats sa = a.step(nine), sb = b.step(s.context());
+  EXPECT_EQ(sa.iterations, 9);
+  EXPECT_EQ(sb.iterations, 9);
+  EXPECT_EQ(sa.loss, sb.loss);
+  EXPECT_EQ(a.base_host().means, b.base_host().means);
+  EXPECT_EQ(a.base_host().sh, b.base_host().sh);
+  a.add_frame(s.frame(6), false);
+  EXPECT_EQ(a.step(s.context()).iterations, 6);  // 0: the params' 6
+  a.add_frame(s.frame(7), false);
+  MappingContext bad = s.context();
+  bad.iterations = -1;
+  const GaussianHost before = a.base_host();
+  EXPECT_THROW(a.run(a.prepare(bad), bad), std::invalid_argument);
+  EXPECT_EQ(a.base_host().means, before.means);
+}
+
 // The session prepares step n + 1 (frames chosen, pass 1 raycast) on the pre-mapping thread while
 // step n runs: the same map, bit for bit, as steps taken one after the other.
 TEST(Mapper, StepsPreparedWhileTheLastRunsGiveTheSameMap) {

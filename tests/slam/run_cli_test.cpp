@@ -59,6 +59,8 @@ TEST(RunCli, WritesOutputsAndScoresGeometryOnTheObservedSurface) {
   ASSERT_GT(t.at("mapping_steps").get<int>(), 0) << t.dump(2);
   EXPECT_EQ(t.at("schedule").get<std::string>(), "sync");
   EXPECT_EQ(t.at("mapping_waits").get<int>(), 0);  // inline steps never wait for another
+  // Every sync step runs mapping.iterations (only live steps scale them).
+  EXPECT_EQ(t.at("mapping_iterations").get<int64_t>(), t.at("mapping_steps").get<int64_t>() * 30) << t.dump(2);
   double stages = 0;
   for (const char* k : {"mapping_raycast_per_step", "mapping_densify_per_step", "mapping_optimise_per_step",
                         "mapping_prune_per_step"}) {

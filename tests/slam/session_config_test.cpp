@@ -65,6 +65,32 @@ TEST(SessionConfig, MappingSchedules) {
   EXPECT_TRUE(mapping_due(MappingSchedule::Live, 1, 1, 1, false));
 }
 
+// A live step's iterations: the paper's `iterations` per N_o frames over the frames it covers, never
+// fewer than `iterations` (a step right after the one before, or the last of a sequence), at most
+// max_scale times them; max_scale 1 keeps every step at `iterations`.
+TEST(SessionConfig, LiveStepIterationsFollowTheFramesCovered) {
+  EXPECT_EQ(live_step_iterations(30, 10, 10, 2.0), 30);  // mapping keeps up: the paper's step
+  EXPECT_EQ(live_step_iterations(30, 10, 3, 2.0), 30);   // fewer than N_o (finish): still a whole step
+  EXPECT_EQ(live_step_iterations(30, 10, 0, 2.0), 30);
+  EXPECT_EQ(live_step_iterations(30, 10, 15, 2.0), 45);  // 3 per frame
+  EXPECT_EQ(live_step_iterations(30, 10, 17, 2.0), 51);
+  EXPECT_EQ(live_step_iterations(30, 10, 20, 2.0), 60);
+  EXPECT_EQ(live_step_iterations(30, 10, 45, 2.0), 60);  // bounded
+  EXPECT_EQ(live_step_iterations(30, 10, 45, 4.0), 120);
+  EXPECT_EQ(live_step_iterations(30, 10, 45, 1.0), 30);  // scale 1: every step the same
+  EXPECT_EQ(live_step_iterations(30, 10, 45, 0.5), 30);  // below 1 counts as 1
+  EXPECT_EQ(live_step_iterations(7, 3, 5, 10.0), 12);    // 7 · 5/3 = 11.67, rounded
+  EXPECT_EQ(live_step_iterations(0, 10, 45, 2.0), 0);
+  // The config's bound: default 2, at least 1, named when out of range.
+  SessionConfig c = camera_config();
+  EXPECT_FLOAT_EQ(c.live_step_scale, 2.0f);
+  apply_override(c, "live_step_scale=3");
+  EXPECT_FLOAT_EQ(c.live_step_scale, 3.0f);
+  EXPECT_NO_THROW(c.validate());
+  c.live_step_scale = 0.5f;
+  expect_rejected_naming(c, "live_step_scale", "a live step scale under 1");
+}
+
 // Live's queue bound: within 4 N_o frames nothing goes; beyond it every other non-keyframe goes,
 // from the newest back, and every keyframe and the newest frame stay.
 TEST(SessionConfig, TheLiveQueueIsThinnedEvenlyKeepingKeyframes) {

@@ -420,6 +420,14 @@ TEST_F(SessionTest, LiveMappingNeverWaitsForARunningStep) {
   EXPECT_EQ(live.waits, 0);        // whatever the timing: a live step starts only when none runs
   EXPECT_GE(live.steps, 2);        // the first at frame 10, the queued rest at the latest at finish()
   EXPECT_LE(live.steps, overlapped.steps);  // 2 when the first step outlasts frames 11-24, as here
+  EXPECT_EQ(overlapped.iterations, overlapped.steps * 200);  // only live steps scale their iterations
+  // Live (live_step_iterations, bound 2): the step at frame 10 covers 10 frames, 200 iterations; when
+  // it outlasts frames 11-24, finish() maps those 14 in one step of 200 · 14/10 = 280. Otherwise a
+  // second step started at frame 20-23 (10-13 frames: 200-260) and finish() took the rest (200).
+  if (live.steps == 2)
+    EXPECT_EQ(live.iterations, 480);
+  else
+    EXPECT_TRUE(live.iterations >= 600 && live.iterations <= 660 && live.iterations % 20 == 0) << live.iterations;
 }
 
 TEST_F(SessionTest, SnapshotRestoresTheMapAndContinues) {
