@@ -6,9 +6,10 @@
 //   2. densify base and reflection Gaussians on the N_local frames (core/gaussians/densify.h; with
 //      densify.reflection_stereo_depth the reflection candidates' depths come from a plane sweep
 //      against the step's other frames, core/slam/reflection_stereo.h);
-//   3. `iterations` = 30 Adam iterations (or MappingContext::iterations), each on one of the selected frames (a seeded shuffle of
-//      the set, cycled): render C, D_b, C_r → L = (1−λ)L1 + λ(1−SSIM) + λ_d L1(D_b) + λ_g‖Sobel C_r‖₁
-//      → backward → Adam on the visible Gaussians of each set;
+//   3. `iterations` = 30 Adam iterations (a step's MappingContext::iterations when set), each on
+//      one of the selected frames (a seeded shuffle of the set, cycled): render C, D_b, C_r →
+//      L = (1−λ)L1 + λ(1−SSIM) + λ_d L1(D_b) + λ_g‖Sobel C_r‖₁ → backward → Adam on the visible
+//      Gaussians of each set;
 //   4. prune both sets (core/gaussians/prune.h), Adam state compacted alongside;
 //   5. publish an immutable MapSnapshot for render() / exports.
 // Frames: add_frame() takes every fused frame (the session may also pass every N_o-th only); the
