@@ -278,8 +278,8 @@ T depth_l1_loss_cpu(Span<const T> d, Span<const T> d_gt, Span<T> v_d, T weight);
 template <class T>
 T ssim_cpu(int w, int h, Span<const T> x, Span<const T> y, Span<T> v_x, T weight, SsimWindow<T> win,
            Span<T> scratch);
-template <class T>
 // values: w h 3 scalars of working memory (a buffer of its own is made when it is smaller).
+template <class T>
 T sobel_l1_loss_cpu(int w, int h, Span<const T> x, Span<T> v_x, T weight, Span<int8_t> signs, Span<T> values = {});
 
 float l1_loss_cuda(Span<const float> x, Span<const float> y, Span<float> v_x, float weight);
