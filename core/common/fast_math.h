@@ -39,7 +39,7 @@ RRG_HD inline float max_f(float a, float b) { return a > b ? a : b; }
 // (FastMath.ExpNegIsWithinTwoUlpOfExp, FastMath.ExpClampedIsWithinTwoUlpOfExp).
 RRG_INLINE float exp_reduced_host(float x) {
   constexpr float kShift = 12582912.0f;      // 1.5 * 2^23
-  constexpr int32_t kShiftBits = 0x4B400000;  // its bits
+  constexpr uint32_t kShiftBits = 0x4B400000u;  // its bits
   const float t = x * 1.44269504f + kShift;
   const float n = t - kShift;  // round(x / ln2)
   const float r = (x - n * 0.693359375f) + n * 2.12194440e-4f;  // ln2 = 0.693359375 - 2.12194440e-4
@@ -51,9 +51,11 @@ RRG_INLINE float exp_reduced_host(float x) {
   p = p * r + 0.5f;
   p = p * r + 1.0f;
   p = p * r + 1.0f;
-  int32_t ti;
+  // 2^n, n in [-126, 127]. Unsigned, so that x = NaN (which the clamps let through, and lanes whose
+  // result is discarded do compute) wraps instead of overflowing a signed int; the result is NaN.
+  uint32_t ti;
   std::memcpy(&ti, &t, sizeof ti);
-  const int32_t bits = (ti - kShiftBits + 127) * (int32_t(1) << 23);  // 2^n, n in [-126, 127]
+  const uint32_t bits = (ti - kShiftBits + 127u) << 23;
   float scale;
   std::memcpy(&scale, &bits, sizeof scale);
   return p * scale;

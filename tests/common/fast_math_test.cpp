@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 
 namespace rrg {
 namespace {
@@ -102,3 +103,15 @@ TEST(FastMath, ExpClampedIsWithinTwoUlpOfExp) {
 
 }  // namespace
 }  // namespace rrg
+
+// NaN in, NaN out, as expf: the clamps let NaN through, and vectorised loops compute lanes whose
+// result is then discarded on NaN inputs (the bilateral filter's holes, a Gaussian without a
+// covariance). The exponent arithmetic must be defined for it (unsigned; a UBSan build reported the
+// signed product overflowing).
+TEST(FastMath, ExpOfNaNIsNaN) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_TRUE(std::isnan(exp_neg(nan)));
+  EXPECT_TRUE(std::isnan(exp_clamped(nan)));
+  EXPECT_TRUE(std::isnan(exp_reduced_host(nan)));
+  EXPECT_TRUE(std::isnan(exp_reduced_host(-nan)));
+}
