@@ -11,7 +11,8 @@
 # ThreadSanitizer cannot see the barriers of GCC's OpenMP runtime (libgomp is not instrumented), so
 # the tsan run gives each thread's parallel loops one OpenMP thread (OMP_NUM_THREADS=1) and leaves
 # out SessionTest.SyncModeIsDeterministic, which asks for three. The session's own threads and locks
-# are what it checks. Environment: JOBS (default 2).
+# are what it checks. Environment: JOBS (default 2); for tsan, RRG_CLI (default build/bin/rrg, built
+# when missing).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -60,7 +61,15 @@ if [ "$kind" = asan ]; then
   export ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
   for t in "$dir"/bin/test_*; do run "$(basename "$t")" "$t"; done
 else
-  cmake --build "$dir" -j "$JOBS" --target test_slam rrg
+  cmake --build "$dir" -j "$JOBS" --target test_slam
+  # the fixtures' `rrg synth` runs as a child process, outside the threads under test: the Release
+  # build's (RRG_CLI overrides it)
+  cli=${RRG_CLI:-$PWD/build/bin/rrg}
+  if [ ! -x "$cli" ]; then
+    cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
+    cmake --build build -j "$JOBS" --target rrg
+  fi
+  export RRG_CLI=$cli
   supp=$(mktemp)
   trap 'rm -f "$supp"' EXIT
   # OpenCV's image reader takes GDAL's driver-manager locks in both orders (inside libgdal)
