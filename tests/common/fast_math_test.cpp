@@ -101,9 +101,6 @@ TEST(FastMath, ExpClampedIsWithinTwoUlpOfExp) {
   std::printf("exp_clamped: worst error %.2f ulp over [-87, 88]\n", worst);
 }
 
-}  // namespace
-}  // namespace rrg
-
 // NaN in, NaN out, as expf: the clamps let NaN through, and vectorised loops compute lanes whose
 // result is then discarded on NaN inputs (the bilateral filter's holes, a Gaussian without a
 // covariance). The exponent arithmetic must be defined for it (unsigned; a UBSan build reported the
@@ -115,3 +112,6 @@ TEST(FastMath, ExpOfNaNIsNaN) {
   EXPECT_TRUE(std::isnan(exp_reduced_host(nan)));
   EXPECT_TRUE(std::isnan(exp_reduced_host(-nan)));
 }
+
+}  // namespace
+}  // namespace rrg
