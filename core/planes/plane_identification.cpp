@@ -79,6 +79,9 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 ReflectiveFillParams IdentificationParams::fill_params() const {
   ReflectiveFillParams f = fill;
   f.noise = segmentation.noise;
+  // One surface for the fill (the mask's own depth against its ring's plane) is one for the table.
+  f.same_surface_angle_deg = table.max_normal_angle_deg;
+  f.same_surface_distance = table.max_distance;
   return f;
 }
 

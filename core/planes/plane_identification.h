@@ -62,7 +62,7 @@ struct IdentificationParams {
   // Depth the sensor lost on reflective masks, filled before identification and fusion
   // (reflective_fill.h; the callers that fuse apply it). Its sensor noise is segmentation's.
   ReflectiveFillParams fill;
-  ReflectiveFillParams fill_params() const;  // fill with segmentation's noise model
+  ReflectiveFillParams fill_params() const;  // fill with segmentation's noise model and the table's same-surface filter
   // "Same surface" for the fill's carried regions: the plane table's geometric filter and overlap.
   RegionMatch region_match() const;
   void validate() const;             // throws std::invalid_argument

@@ -34,6 +34,10 @@ void ReflectiveFillParams::validate() const {
   if (min_sides < 1 || min_sides > 4) fail("min_sides", "must be 1..4");
   if (!(min_side_share >= 0.0f && min_side_share <= 0.25f)) fail("min_side_share", "must be in [0, 0.25]");
   if (!(min_region_share >= 0.0f && min_region_share < 1.0f)) fail("min_region_share", "must be in [0, 1)");
+  if (!(same_surface_angle_deg >= 0.0f && same_surface_angle_deg < 90.0f))
+    fail("same_surface_angle_deg", "must be in [0, 90)");
+  if (!(same_surface_distance >= 0.0f) || !std::isfinite(same_surface_distance))
+    fail("same_surface_distance", "must be >= 0");
   if (!(max_ray_angle_deg > 0.0f && max_ray_angle_deg < 90.0f)) fail("max_ray_angle_deg", "must be in (0, 90)");
   if (ransac_iterations < 1) fail("ransac_iterations", "must be >= 1");
   if (!(max_depth > 0.0f) || !std::isfinite(max_depth)) fail("max_depth", "must be > 0");
@@ -98,8 +102,8 @@ struct RingPoint {
   float tol;
 };
 
-// RANSAC over (a stride of) the ring points, then a least-squares refit to the inliers.
-bool fit_ring_plane(const std::vector<RingPoint>& ring, const ReflectiveFillParams& params, Plane& plane) {
+// RANSAC over (a stride of) the points, then a least-squares refit to the inliers.
+bool fit_points_plane(const std::vector<RingPoint>& ring, const ReflectiveFillParams& params, Plane& plane) {
   constexpr size_t kMaxScored = 1024;  // a stride of the ring scores the hypotheses; the refit takes all
   const size_t stride = std::max<size_t>(1, ring.size() / kMaxScored);
   std::mt19937 rng(0x5eedu);  // deterministic: the same frame gives the same fill
@@ -128,6 +132,50 @@ bool fit_ring_plane(const std::vector<RingPoint>& ring, const ReflectiveFillPara
   const PlaneFit fit = fit_plane(m);  // normal towards the camera centre: d > 0
   if (!fit.valid) return false;
   plane = fit.plane;
+  return true;
+}
+
+// How far apart two planes may lie and still be one surface for the fill: max(same_surface_distance,
+// w + tol), w the width of a ring of ring_px pixels in metres at depth z and tol the inlier
+// tolerance there (see own_surface_plane).
+float surface_bound(int ring_px, float z, const Intrinsics& K, const ReflectiveFillParams& params) {
+  const float ring_m = float(ring_px) * z / std::min(K.fx, K.fy);
+  return std::max(params.same_surface_distance, ring_m + params.tolerance(z));
+}
+
+// The surface the sensor kept on a mask: a plane that at least 1 − min_missing of the mask's pixels
+// lie on (within the inlier tolerance), and that is the ring's surface: normals within
+// same_surface_angle_deg and the inliers' centroid within surface_bound of the ring's plane (the
+// global plane table's geometric filter, 10° and 0.1 m, widened to the ring's width plus the
+// tolerance where that is more). The ring places its plane no closer than that: across a crease (a
+// floor's edge against the walls) the ring is a strip of wall r pixels wide, and a plane through
+// that strip may lie anywhere in it, a tolerance beyond. Glass seen through shows the mirrored room,
+// which is farther behind; lost glass has too little depth. Such a mask is kept, never filled.
+bool own_surface_plane(const DepthImage& depth, const MaskImage& mask, const Box& box, int64_t mask_pixels, int ring_px,
+                       const Intrinsics& K, const ReflectiveFillParams& params, const Plane& ring_plane, Plane& plane) {
+  std::vector<RingPoint> points;
+  for (int v = box.y0; v <= box.y1; ++v)
+    for (int u = box.x0; u <= box.x1; ++u) {
+      const float z = depth(u, v);
+      if (!mask(u, v) || !(z > 0.0f) || !std::isfinite(z)) continue;
+      points.push_back({z * K.unproject(float(u), float(v), 1.0f), u, v, params.tolerance(z)});
+    }
+  const float needed = (1.0f - params.min_missing) * float(mask_pixels);
+  if (int64_t(points.size()) < params.min_ring_points || float(points.size()) < needed) return false;
+  Plane own;
+  if (!fit_points_plane(points, params, own)) return false;
+  Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
+  size_t inliers = 0;
+  for (const RingPoint& p : points)
+    if (std::abs(own.signed_distance(p.p)) < p.tol) {
+      centroid += p.p;
+      ++inliers;
+    }
+  if (float(inliers) < needed) return false;
+  centroid /= float(inliers);
+  if (own.n.dot(ring_plane.n) < std::cos(params.same_surface_angle_deg * float(M_PI) / 180.0f)) return false;
+  if (!(std::abs(ring_plane.signed_distance(centroid)) <= surface_bound(ring_px, centroid.z(), K, params))) return false;
+  plane = own;
   return true;
 }
 
@@ -243,7 +291,7 @@ ReflectiveFillResult fill_reflective_depth(DepthImage& depth, std::span<const Se
       done("too little depth around the mask");
       continue;
     }
-    if (!fit_ring_plane(ring, params, rec.plane)) {
+    if (!fit_points_plane(ring, params, rec.plane)) {
       done("no plane around the mask");
       continue;
     }
@@ -265,6 +313,10 @@ ReflectiveFillResult fill_reflective_depth(DepthImage& depth, std::span<const Se
     }
     rec.inlier_ratio = float(inliers) / float(rec.ring_points);
     for (const int64_t s : side) rec.sides += s > 0 && float(s) >= params.min_side_share * float(inliers);
+    // Where the sensor kept the surface, lost and behind are measured against it (and the mask is
+    // kept): the ring's plane is fitted to what borders the mask, and around a floor that is the foot
+    // of the walls (a crease on two sides or more), a plane off the floor that leaves it "behind".
+    rec.own_surface = own_surface_plane(depth, sm.mask, box, rec.pixels, r, K, params, rec.plane, rec.plane);
     for (int v = box.y0; v <= box.y1; ++v)
       for (int u = box.x0; u <= box.x1; ++u)
         if (sm.mask(u, v)) rec.missing += lost(depth(u, v), z_at(u, v), params);
@@ -277,6 +329,7 @@ ReflectiveFillResult fill_reflective_depth(DepthImage& depth, std::span<const Se
       continue;
     }
     if (float(rec.missing) < params.min_missing * float(rec.pixels)) {
+      rec.kept = true;
       done("the sensor kept the surface");
       continue;
     }
@@ -359,6 +412,38 @@ Box footprint_window(const Footprint& fp, const Eigen::Isometry3f& T_cw, const I
 Eigen::Vector3f footprint_centre(const Footprint& fp) {
   const Eigen::Vector2f c = 0.5f * (fp.box().min + fp.box().max);
   return fp.basis().origin + c.x() * fp.basis().u + c.y() * fp.basis().v;
+}
+
+// The region of `label` that most of a mask's pixels (every second one per axis, `sampled` of them)
+// meet at pose T_wc, their rays reaching its plane from the front within its footprint (`on` of
+// them); nullptr when none does.
+const FillRegion* region_under_mask(const MaskImage& mask, const Box& box, const std::string& label,
+                                    std::span<const FillRegion> regions, const Intrinsics& K,
+                                    const Eigen::Isometry3f& T_wc, const ReflectiveFillParams& params,
+                                    int64_t& sampled, int64_t& on_best) {
+  const float cos_max = std::cos(params.max_ray_angle_deg * float(M_PI) / 180.0f);
+  const Eigen::Isometry3f T_cw = T_wc.inverse();
+  sampled = on_best = 0;
+  for (int v = box.y0; v <= box.y1; v += 2)
+    for (int u = box.x0; u <= box.x1; u += 2) sampled += mask(u, v) != 0;
+  const FillRegion* best = nullptr;
+  for (const FillRegion& region : regions) {
+    if (region.label != label) continue;
+    const Plane pc = region.plane.transformed(T_cw);
+    if (!(pc.d > 0.0f)) continue;  // seen from behind
+    int64_t on = 0;
+    for (int v = box.y0; v <= box.y1; v += 2)
+      for (int u = box.x0; u <= box.x1; u += 2) {
+        if (!mask(u, v)) continue;
+        const float z = plane_depth(pc, K, u, v, cos_max, params.max_depth);
+        on += z > 0.0f && region.footprint.covers(T_wc * (z * K.unproject(float(u), float(v), 1.0f)));
+      }
+    if (on > on_best) {
+      on_best = on;
+      best = &region;
+    }
+  }
+  return best;
 }
 
 }  // namespace
@@ -448,28 +533,8 @@ int64_t fill_failed_masks_from_regions(DepthImage& depth, ReflectiveFillResult& 
     int64_t pixels = 0;
     const Box box = mask_box(mask, pixels);
     if (pixels < params.min_mask_pixels) continue;
-    // The region of the mask's label that the most of its pixels (every second one per axis) meet.
-    int64_t sampled = 0;
-    for (int v = box.y0; v <= box.y1; v += 2)
-      for (int u = box.x0; u <= box.x1; u += 2) sampled += mask(u, v) != 0;
-    const FillRegion* best = nullptr;
-    int64_t best_on = 0;
-    for (const FillRegion& region : regions) {
-      if (region.label != rec.label) continue;
-      const Plane pc = region.plane.transformed(T_cw);
-      if (!(pc.d > 0.0f)) continue;  // seen from behind
-      int64_t on = 0;
-      for (int v = box.y0; v <= box.y1; v += 2)
-        for (int u = box.x0; u <= box.x1; u += 2) {
-          if (!mask(u, v)) continue;
-          const float z = plane_depth(pc, K, u, v, cos_max, params.max_depth);
-          on += z > 0.0f && region.footprint.covers(T_wc * (z * K.unproject(float(u), float(v), 1.0f)));
-        }
-      if (on > best_on) {
-        best_on = on;
-        best = &region;
-      }
-    }
+    int64_t sampled = 0, best_on = 0;
+    const FillRegion* best = region_under_mask(mask, box, rec.label, regions, K, T_wc, params, sampled, best_on);
     if (!best || float(best_on) <= params.min_region_share * float(sampled)) continue;
     ReflectiveFillMask from_region = rec;
     from_region.plane = best->plane.transformed(T_cw);
@@ -492,6 +557,55 @@ int64_t fill_failed_masks_from_regions(DepthImage& depth, ReflectiveFillResult& 
     total += rec.filled;
   }
   return total;
+}
+
+size_t drop_refuted_regions(std::vector<FillRegion>& regions, const ReflectiveFillResult& result,
+                            std::span<const SemanticMask> masks, const DepthImage& depth, const Intrinsics& K,
+                            const Eigen::Isometry3f& T_wc, const ReflectiveFillParams& params) {
+  params.validate();
+  if (K.width != depth.width() || K.height != depth.height())
+    throw std::invalid_argument(fmt::format("drop_refuted_regions: intrinsics {}x{} but depth {}x{}", K.width, K.height,
+                                            depth.width(), depth.height()));
+  const float cos_max = std::cos(params.max_ray_angle_deg * float(M_PI) / 180.0f);
+  const Eigen::Isometry3f T_cw = T_wc.inverse();
+  size_t dropped = 0;
+  for (const ReflectiveFillMask& rec : result.masks) {
+    if (!rec.kept) continue;
+    if (rec.mask_index >= masks.size() || !masks[rec.mask_index].mask.same_size(depth))
+      throw std::invalid_argument("drop_refuted_regions: the masks are not those of the fill");
+    const MaskImage& mask = masks[rec.mask_index].mask;
+    int64_t pixels = 0;
+    const Box box = mask_box(mask, pixels);
+    int64_t sampled = 0, on = 0;
+    const FillRegion* region = region_under_mask(mask, box, rec.label, regions, K, T_wc, params, sampled, on);
+    if (!region || float(on) <= params.min_region_share * float(sampled)) continue;
+    // Where the region would write (the mask's pixels its footprint covers with depth lost against
+    // its plane): the kept surface behind it by no more than surface_bound is that surface, which
+    // the region misplaces; farther behind, the mask sees through the region's glass (a mask inside
+    // the glass, whose ring is the room seen through it too), and the region stands.
+    const Plane pc = region->plane.transformed(T_cw);
+    std::vector<float> behind;
+    double z_sum = 0.0;  // their depths, for the bound
+    for (int v = box.y0; v <= box.y1; v += 2)
+      for (int u = box.x0; u <= box.x1; u += 2) {
+        if (!mask(u, v)) continue;
+        const float z = plane_depth(pc, K, u, v, cos_max, params.max_depth);
+        if (!(z > 0.0f) || !region->footprint.covers(T_wc * (z * K.unproject(float(u), float(v), 1.0f)))) continue;
+        const float d = depth(u, v);
+        if (d > 0.0f && std::isfinite(d) && lost(d, z, params)) {
+          behind.push_back(-pc.signed_distance(d * K.unproject(float(u), float(v), 1.0f)));
+          z_sum += d;
+        }
+      }
+    if (behind.empty() || float(behind.size()) < params.min_missing * float(on)) continue;  // it writes little
+    const auto mid = behind.begin() + ptrdiff_t(behind.size() / 2);
+    std::nth_element(behind.begin(), mid, behind.end());
+    const float z_mean = float(z_sum / double(behind.size()));
+    if (!(*mid <= surface_bound(ring_width(box, params), z_mean, K, params))) continue;
+    regions.erase(regions.begin() + (region - regions.data()));
+    ++dropped;
+  }
+  return dropped;
 }
 
 void copy_filled_depth(const DepthImage& from, const MaskImage& filled, DepthImage& to) {

@@ -6,9 +6,10 @@
 // identification and fusion, each reflective mask of the cue whose pixels have largely no depth,
 // or depth behind the surface around it, is filled with the plane that the valid depth in a ring
 // just outside the mask lies on (the wall or frame a mirror hangs in), provided that ring is
-// planar and surrounds the mask. Pixels in front of that plane (an occluder, the mirror's own
-// frame) keep their depth. A departure from the paper, which assumes depth on its planes
-// (docs/planes.md "Mirrors without depth").
+// planar and surrounds the mask, and the mask's own depth is not that surface (a floor whose ring
+// is the foot of the walls around it fits a plane off the floor). Pixels in front of that plane (an
+// occluder, the mirror's own frame) keep their depth. A departure from the paper, which assumes
+// depth on its planes (docs/planes.md "Mirrors without depth").
 #include "core/common/camera.h"
 #include "core/common/depth_noise_model.h"
 #include "core/common/image.h"
@@ -64,6 +65,13 @@ struct ReflectiveFillParams {
   // its label when more than this share of its pixels meet that region's footprint: a surface found
   // before, which the mask shows again (fill_failed_masks_from_regions).
   float min_region_share = 0.5f;
+  // A mask at least 1 − min_missing of whose pixels have depth on one plane that is the ring's
+  // surface by the global plane table's geometric filter (the supplement's 10° and 0.1 m;
+  // fill_params() takes the table's) is a surface the sensor kept, and is left alone, whatever the
+  // ring's plane says of it (own_surface_plane in the .cpp: the distance bound widens to the
+  // ring's width plus the inlier tolerance where that is more).
+  float same_surface_angle_deg = 10.0f;
+  float same_surface_distance = 0.1f;
   float max_ray_angle_deg = 80.0f;  // no fill where a ray meets the plane more obliquely
   int ransac_iterations = 128;      // deterministic (fixed seed)
   float max_depth = 10.0f;          // filled depths beyond this are left out, metres
@@ -88,6 +96,8 @@ struct ReflectiveFillMask {
   Plane plane;                // camera frame, facing the camera (d > 0), when fitted
   bool fitted = false;
   bool from_region = false;   // the plane is a carried region's (fill_failed_masks_from_regions)
+  bool own_surface = false;   // the plane is the mask's own depth's, the ring's surface, on 1 − min_missing of it
+  bool kept = false;          // too little of the mask lost: the sensor kept the surface (not filled)
   std::string skipped;        // why nothing was written ("" when filled)
 };
 
@@ -145,7 +155,22 @@ size_t merge_fill_regions(std::vector<FillRegion>& carried, std::vector<FillRegi
 ReflectiveFillResult fill_from_regions(DepthImage& depth, std::span<const FillRegion> regions, const Intrinsics& K,
                                        const Eigen::Isometry3f& T_wc, const ReflectiveFillParams& params);
 
-// The masks `result` left unfilled (a ring that is not planar, seen on too few sides, ...) filled
+// Removes the carried regions that this frame's masks refute, and returns how many: a mask the
+// sensor kept (ReflectiveFillMask::kept: its depth is a surface, not lost) more than
+// min_region_share of whose pixels meet the footprint of a region of its label, where at least
+// min_missing of those would be lost against the region's plane (the region would write over them)
+// and their median distance behind it is within the fill's one-surface bound (max(0.1 m, the
+// mask's ring width + the inlier tolerance), own_surface_plane): the region misplaces the surface
+// the sensor sees. Farther behind, the mask sees through the region's glass and the region stands.
+// A region from a wrong fill is then not carried over every later frame. Call it before
+// fill_failed_masks_from_regions and fill_from_regions. `depth` is the frame's depth the masks were
+// tested on; throws std::invalid_argument when the sizes differ or the masks are not the fill's.
+size_t drop_refuted_regions(std::vector<FillRegion>& regions, const ReflectiveFillResult& result,
+                            std::span<const SemanticMask> masks, const DepthImage& depth, const Intrinsics& K,
+                            const Eigen::Isometry3f& T_wc, const ReflectiveFillParams& params);
+
+// The masks `result` left unfilled (a ring that is not planar, seen on too few sides, a surface the
+// ring and the mask agree on inside glass seen through, ...) filled
 // from the carried regions at pose T_wc: a mask more than min_region_share of whose pixels meet the
 // footprint (dilated by one cell) of a region of its label takes that region's plane, and is filled
 // as fill_reflective_depth fills from a fitted plane (min_missing, the glass beyond it). Their

@@ -394,7 +394,8 @@ FrameReport Session::process(const SessionFrame& frame) {
     mask_fill = fill_reflective_depth(filled, *masks, s.K, s.config.planes.fill_params());
     report.filled_pixels = mask_fill->pixels;
     for (const ReflectiveFillMask& m : mask_fill->masks)
-      spdlog::debug("frame {}: {} mask, {} px, {} missing: {}", frame.index, m.label, m.pixels, m.missing,
+      spdlog::debug("frame {}: {} mask, {} px, {} missing{}: {}", frame.index, m.label, m.pixels, m.missing,
+                    m.own_surface ? " (of its own depth's plane)" : "",
                     m.skipped.empty() ? fmt::format("{} px filled", m.filled) : m.skipped);
     report.times.identify = ms_since(tf);
   }
@@ -482,6 +483,13 @@ FrameReport Session::process(const SessionFrame& frame) {
     DepthImage carried = mask_fill ? std::move(filled) : frame.depth;  // the masks' fill, if any
     MaskImage written = mask_fill ? mask_fill->filled : MaskImage(s.K.width, s.K.height, 0);
     int64_t pixels = 0;  // beyond the masks' own fill
+    if (s.config.planes.fill.carry && mask_fill) {
+      // A mask the sensor kept refutes a carried region that would write over it: this frame's
+      // depth, not an earlier fill, decides there (drop_refuted_regions).
+      if (const size_t dropped =
+              drop_refuted_regions(s.fill_regions, *mask_fill, *masks, frame.depth, s.K, report.T_wc, params))
+        spdlog::debug("frame {}: {} carried fill region(s) dropped: a mask's own depth refutes them", frame.index, dropped);
+    }
     size_t unseen = s.fill_regions.size();  // the regions no mask of this frame showed again come first
     if (s.config.planes.fill.carry) {
       if (mask_fill) {
