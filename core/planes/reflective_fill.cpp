@@ -313,13 +313,13 @@ ReflectiveFillResult fill_reflective_depth(DepthImage& depth, std::span<const Se
     }
     rec.inlier_ratio = float(inliers) / float(rec.ring_points);
     for (const int64_t s : side) rec.sides += s > 0 && float(s) >= params.min_side_share * float(inliers);
-    // Where the sensor kept the surface, lost and behind are measured against it (and the mask is
-    // kept): the ring's plane is fitted to what borders the mask, and around a floor that is the foot
-    // of the walls (a crease on two sides or more), a plane off the floor that leaves it "behind".
-    rec.own_surface = own_surface_plane(depth, sm.mask, box, rec.pixels, r, K, params, rec.plane, rec.plane);
-    for (int v = box.y0; v <= box.y1; ++v)
-      for (int u = box.x0; u <= box.x1; ++u)
-        if (sm.mask(u, v)) rec.missing += lost(depth(u, v), z_at(u, v), params);
+    const auto count_missing = [&] {
+      rec.missing = 0;
+      for (int v = box.y0; v <= box.y1; ++v)
+        for (int u = box.x0; u <= box.x1; ++u)
+          if (sm.mask(u, v)) rec.missing += lost(depth(u, v), z_at(u, v), params);
+    };
+    count_missing();
     if (rec.inlier_ratio < params.min_inlier_ratio) {
       done(fmt::format("the depth around the mask is not planar ({:.2f} on the plane)", rec.inlier_ratio));
       continue;
@@ -328,7 +328,14 @@ ReflectiveFillResult fill_reflective_depth(DepthImage& depth, std::span<const Se
       done(fmt::format("the plane around the mask is seen on {} side(s)", rec.sides));
       continue;
     }
-    if (float(rec.missing) < params.min_missing * float(rec.pixels)) {
+    // A mask about to be filled whose own depth is the ring's surface is kept (its plane and missing
+    // then that surface's): the ring's plane is fitted to what borders the mask, and around a floor
+    // that is the foot of the walls (a crease on two sides or more), a plane off the floor that
+    // leaves it "behind". (A mask the ring's plane already keeps needs no second fit.)
+    if (float(rec.missing) >= params.min_missing * float(rec.pixels) &&
+        (rec.own_surface = own_surface_plane(depth, sm.mask, box, rec.pixels, r, K, params, rec.plane, rec.plane)))
+      count_missing();
+    if (rec.own_surface || float(rec.missing) < params.min_missing * float(rec.pixels)) {
       rec.kept = true;
       done("the sensor kept the surface");
       continue;
