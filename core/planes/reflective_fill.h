@@ -97,7 +97,7 @@ struct ReflectiveFillMask {
   bool fitted = false;
   bool from_region = false;   // the plane is a carried region's (fill_failed_masks_from_regions)
   bool own_surface = false;   // the plane is the mask's own depth's, the ring's surface, on 1 − min_missing of it
-  bool kept = false;          // too little of the mask lost: the sensor kept the surface (not filled)
+  bool kept = false;          // the sensor kept the surface (too little lost, or own_surface): not filled
   std::string skipped;        // why nothing was written ("" when filled)
 };
 
