@@ -116,9 +116,7 @@ PlaneEvalReport run_plane_eval(const PlaneEvalOptions& options) {
       const ReflectiveFillResult filled = fill_reflective_depth(frame.depth, *masks, K, options.params.fill_params());
       add_glass_beyond(filled, *masks);  // as the session's identification frames do
       for (const ReflectiveFillMask& m : filled.masks)
-        spdlog::debug("frame {}: {} mask, {} px, {} missing{}: {}", k, m.label, m.pixels, m.missing,
-                      m.own_surface ? " (of its own depth's plane)" : "",
-                      m.skipped.empty() ? fmt::format("{} px filled", m.filled) : m.skipped);
+        spdlog::debug("frame {}: {}", k, describe(m));
       report.filled_pixels += filled.pixels;
       fill_ms += ms_since(t0);
       ++fills;

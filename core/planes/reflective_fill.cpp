@@ -566,6 +566,12 @@ int64_t fill_failed_masks_from_regions(DepthImage& depth, ReflectiveFillResult& 
   return total;
 }
 
+std::string describe(const ReflectiveFillMask& m) {
+  return fmt::format("{} mask, {} px, {} missing{}: {}", m.label, m.pixels, m.missing,
+                     m.own_surface ? " (of its own depth's plane)" : "",
+                     m.skipped.empty() ? fmt::format("{} px filled", m.filled) : m.skipped);
+}
+
 size_t drop_refuted_regions(std::vector<FillRegion>& regions, const ReflectiveFillResult& result,
                             std::span<const SemanticMask> masks, const DepthImage& depth, const Intrinsics& K,
                             const Eigen::Isometry3f& T_wc, const ReflectiveFillParams& params) {

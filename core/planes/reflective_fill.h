@@ -101,6 +101,10 @@ struct ReflectiveFillMask {
   std::string skipped;        // why nothing was written ("" when filled)
 };
 
+// One line on what happened to a mask, for logs: "floor mask, 9000 px, 12 missing (of its own
+// depth's plane): the sensor kept the surface".
+std::string describe(const ReflectiveFillMask& mask);
+
 struct ReflectiveFillResult {
   std::vector<ReflectiveFillMask> masks;  // one per reflective mask, in the cue's order
   MaskImage filled;                       // 1 where depth was written; the frame's size

@@ -394,9 +394,7 @@ FrameReport Session::process(const SessionFrame& frame) {
     mask_fill = fill_reflective_depth(filled, *masks, s.K, s.config.planes.fill_params());
     report.filled_pixels = mask_fill->pixels;
     for (const ReflectiveFillMask& m : mask_fill->masks)
-      spdlog::debug("frame {}: {} mask, {} px, {} missing{}: {}", frame.index, m.label, m.pixels, m.missing,
-                    m.own_surface ? " (of its own depth's plane)" : "",
-                    m.skipped.empty() ? fmt::format("{} px filled", m.filled) : m.skipped);
+      spdlog::debug("frame {}: {}", frame.index, describe(m));
     report.times.identify = ms_since(tf);
   }
   // Tracking leaves out the pixels the fill writes (lost, or seen through the glass), so that a
