@@ -18,6 +18,19 @@ std::string size_text(int w, int h) { return std::to_string(w) + "x" + std::to_s
 
 }  // namespace
 
+void to_level0_pixels(std::vector<cv::KeyPoint>& keypoints, int width, int height, float scale_factor) {
+  for (cv::KeyPoint& kp : keypoints) {
+    if (kp.octave <= 0) continue;
+    // OpenCV's level l: s_l = (float) f^l, size (cvRound(W / s_l), cvRound(H / s_l)), each level
+    // resized from the one before with pixel centres at x + 0.5, then pt = s_l x_l.
+    const float s = float(std::pow(double(scale_factor), double(kp.octave)));
+    const int wl = cvRound(float(width) / s), hl = cvRound(float(height) / s);
+    const float xl = kp.pt.x / s, yl = kp.pt.y / s;
+    kp.pt.x = (xl + 0.5f) * (float(width) / float(wl)) - 0.5f;
+    kp.pt.y = (yl + 0.5f) * (float(height) / float(hl)) - 0.5f;
+  }
+}
+
 cv::Mat to_gray8(const ColorImage& color) {
   cv::Mat gray(color.height(), color.width(), CV_8U);
   for (int y = 0; y < color.height(); ++y) {
@@ -54,6 +67,7 @@ OrbFrame extract_orb(const ColorImage& color, const DepthImage& depth, const Int
                                          cv::ORB::HARRIS_SCORE, std::min(31, edge), 20);
   OrbFrame f;
   orb->detectAndCompute(gray, allowed, f.keypoints, f.descriptors);
+  to_level0_pixels(f.keypoints, color.width(), color.height(), params.scale_factor);
   f.points_cam.resize(f.keypoints.size(), Eigen::Vector3f::Zero());
   for (size_t i = 0; i < f.keypoints.size(); ++i) {
     const int x = int(std::lround(f.keypoints[i].pt.x)), y = int(std::lround(f.keypoints[i].pt.y));

@@ -28,6 +28,14 @@ cv::Mat to_gray8(const ColorImage& color);
 OrbFrame extract_orb(const ColorImage& color, const DepthImage& depth, const Intrinsics& K,
                      const MaskImage* exclude, const OrbParams& params);
 
+// OpenCV's ORB reports a keypoint found on pyramid level l at s_l·x_l, s_l = f^l, as if level l's
+// pixel x_l covered level 0 from s_l·x_l. Its levels are resized with pixel centres at x + 0.5 and
+// rounded sizes W_l = round(W / s_l), so x_l's centre is at (x_l + 0.5)·W / W_l − 0.5 on level 0:
+// at 320x240 the reported point is 0.1 px off at level 1 and 1.3–2.6 px at level 7, the same way
+// in every frame, so a point seen at different levels in two frames moves. This maps OpenCV's
+// coordinates (octave ≥ 1) to level-0 pixel centres in place; extract_orb applies it.
+void to_level0_pixels(std::vector<cv::KeyPoint>& keypoints, int width, int height, float scale_factor);
+
 // Hamming distance of two 32-byte ORB descriptors.
 int hamming_distance(const uint8_t* a, const uint8_t* b);
 

@@ -1,0 +1,95 @@
+// ORB keypoints in level-0 pixel coordinates at every pyramid level (to_level0_pixels).
+#include "core/tracking/orb_features.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <random>
+
+namespace rrg {
+namespace {
+
+// Grey rectangles of 4 to 120 px, one over the other: corners at every scale of the pyramid.
+ColorImage rectangles(int width, int height, uint32_t seed) {
+  ColorImage img(width, height, Color::Constant(0.5f));
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  for (int k = 0; k < 600; ++k) {
+    const int w = 4 + int(116 * unit(rng) * unit(rng)), h = 4 + int(116 * unit(rng) * unit(rng));
+    const int x0 = int(unit(rng) * float(width - w)), y0 = int(unit(rng) * float(height - h));
+    const float g = unit(rng);
+    for (int y = y0; y < y0 + h; ++y)
+      for (int x = x0; x < x0 + w; ++x) img(x, y) = Color::Constant(g);
+  }
+  return img;
+}
+
+ColorImage flipped(const ColorImage& img, bool horizontal) {
+  ColorImage out(img.width(), img.height());
+  for (int y = 0; y < img.height(); ++y)
+    for (int x = 0; x < img.width(); ++x)
+      out(x, y) = horizontal ? img(img.width() - 1 - x, y) : img(x, img.height() - 1 - y);
+  return out;
+}
+
+// A mirrored image must give mirrored keypoints: OpenCV's pyramid (centre-aligned bilinear
+// resizing) and FAST/Harris are symmetric under a flip, so a corner at level-0 pixel x in one
+// image is at W − 1 − x in the other, at every level, only when the coordinates are level-0 pixel
+// centres. OpenCV's own s_l·x_l misses the mirror by 0.2 px (level 1) to several pixels (level 7)
+// at 640x480; this test fails without to_level0_pixels.
+TEST(OrbFeatures, KeypointsOfAMirroredImageAreMirroredAtEveryLevel) {
+  const int W = 640, H = 480;
+  const Intrinsics K{500.0f, 500.0f, 319.5f, 239.5f, W, H};
+  const DepthImage depth(W, H, 1.0f);
+  OrbParams params;
+  const ColorImage a = rectangles(W, H, 7);
+  const OrbFrame fa = extract_orb(a, depth, K, nullptr, params);
+  for (const bool horizontal : {true, false}) {
+    SCOPED_TRACE(horizontal ? "left-right flip" : "up-down flip");
+    const OrbFrame fb = extract_orb(flipped(a, horizontal), depth, K, nullptr, params);
+    std::map<int, int> total, mirrored;
+    for (const cv::KeyPoint& p : fa.keypoints) {
+      const float mx = horizontal ? float(W - 1) - p.pt.x : p.pt.x;
+      const float my = horizontal ? p.pt.y : float(H - 1) - p.pt.y;
+      ++total[p.octave];
+      for (const cv::KeyPoint& q : fb.keypoints)
+        if (q.octave == p.octave && std::abs(q.pt.x - mx) < 0.02f && std::abs(q.pt.y - my) < 0.02f) {
+          ++mirrored[p.octave];
+          break;
+        }
+    }
+    int levels_checked = 0;
+    for (const auto& [octave, n] : total) {
+      if (n < 10) continue;
+      ++levels_checked;
+      // Ties in the Harris ranking and the border rule may change a few keypoints, not most.
+      EXPECT_GE(mirrored[octave], 0.7 * n) << "octave " << octave << ": " << mirrored[octave] << " of " << n
+                                           << " keypoints have a mirror image within 0.02 px";
+    }
+    EXPECT_GE(levels_checked, 6);
+  }
+}
+
+// The mapping by hand at 320x240, level 7: s = 1.2^7 = 3.5832, level size 89 x 67; OpenCV's
+// x_7 = 44 (reported 157.66) is the centre of level-0 pixels (44.5) · 320 / 89 − 0.5 = 159.50.
+TEST(OrbFeatures, LevelCoordinatesMapToLevelZeroPixelCentres) {
+  const float s7 = float(std::pow(1.2, 7.0));
+  std::vector<cv::KeyPoint> kps(3);
+  kps[0].pt = {44.0f * s7, 10.0f * s7};
+  kps[0].octave = 7;
+  kps[1].pt = {12.0f, 34.0f};  // level 0: unchanged
+  kps[1].octave = 0;
+  kps[2].pt = {0.0f, 0.0f};  // level 1 (267 x 200): pixel 0's centre is at 0.5 · 320 / 267 − 0.5
+  kps[2].octave = 1;
+  to_level0_pixels(kps, 320, 240, 1.2f);
+  EXPECT_NEAR(kps[0].pt.x, 44.5 * 320.0 / 89.0 - 0.5, 1e-4);
+  EXPECT_NEAR(kps[0].pt.y, 10.5 * 240.0 / 67.0 - 0.5, 1e-4);
+  EXPECT_FLOAT_EQ(kps[1].pt.x, 12.0f);
+  EXPECT_FLOAT_EQ(kps[1].pt.y, 34.0f);
+  EXPECT_NEAR(kps[2].pt.x, 0.5 * 320.0 / 267.0 - 0.5, 1e-5);
+  EXPECT_NEAR(kps[2].pt.y, 0.5 * 240.0 / 200.0 - 0.5, 1e-5);
+}
+
+}  // namespace
+}  // namespace rrg
