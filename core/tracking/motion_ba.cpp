@@ -108,11 +108,18 @@ BaResult optimize_pose(std::span<const BaObservation> observations, const Intrin
     }
   }
   double sum = 0.0;
+  Matrix6d H = Matrix6d::Zero();  // in the BA's ξ (T_cw ← exp(ξ) T_cw)
   for (size_t i = 0; i < observations.size(); ++i) {
     if (!result.inlier[i]) continue;
     ++result.inliers;
-    sum += project(observations[i], K, bf, T_cw).e.head<2>().squaredNorm();
+    const Projection pr = project(observations[i], K, bf, T_cw);
+    sum += pr.e.head<2>().squaredNorm();
+    const auto J = pr.J.topRows(pr.dims);
+    H += observations[i].inv_sigma2 * J.transpose() * J;
   }
+  // The prior's e ≈ A ξ with A = −Ad(T_wc) (add_prior), so Λ_e = A⁻ᵀ H A⁻¹, A⁻¹ = −Ad(T_cw).
+  const Matrix6d A_inv = adjoint(T_cw);
+  result.information = A_inv.transpose() * H * A_inv;
   result.rms_px = result.inliers > 0 ? std::sqrt(sum / result.inliers) : 0.0;
   result.T_wc = T_cw.inverse();
   return result;

@@ -28,6 +28,10 @@ struct BaResult {
   int inliers = 0;               // observations passing the χ² test at the final pose
   std::vector<uint8_t> inlier;   // per observation
   double rms_px = 0.0;           // RMS reprojection error of the inliers (u, v only)
+  // Σ Ω_i J_iᵀ J_i of the inliers at the final pose (no Huber weight) in the PosePrior's coordinates
+  // (e = [ρ; φ] of T_wc T⁻¹): the information the features claim about the pose, e.g. to check it
+  // against ground truth (bench/consistency).
+  Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();
 };
 
 // A Gaussian prior on the pose: e = [ρ; φ] of T_wc T_prior⁻¹ (left, world-frame twist, as ICP's

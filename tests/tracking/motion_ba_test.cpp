@@ -54,6 +54,33 @@ Eigen::Isometry3d perturbed(const Eigen::Isometry3d& T) {
   return se3_exp(xi) * T;
 }
 
+// BaResult::information is the cost's curvature in the PosePrior's coordinates: with noise-free
+// observations, moving the pose by e (T_wc ← exp(e) T_wc, a world-frame twist as the prior's)
+// raises Σ Ω |z − π|² by eᵀ Λ e to second order. Checked along each axis and two mixed directions,
+// with e small enough that every observation stays an inlier. (The BA's own coordinates, T_cw ←
+// exp(ξ) T_cw, differ from these by the adjoint of a pose 3 m from the origin and would fail.)
+TEST(MotionBa, InformationIsTheCostCurvatureInThePriorsCoordinates) {
+  Problem p = make_problem(200, 0.0, 3);
+  for (BaObservation& o : p.obs) {  // exact observations: the cost is 0 at the true pose
+    const Eigen::Vector3d c = p.T_true.inverse() * o.X_w;
+    o.uv = {p.K.fx * c.x() / c.z() + p.K.cx, p.K.fy * c.y() / c.z() + p.K.cy};
+    if (o.u_right >= 0) o.u_right = o.uv.x() - kBf / c.z();
+  }
+  const BaResult r = optimize_pose(p.obs, p.K, kBf, p.T_true, BaParams{});
+  ASSERT_EQ(r.inliers, int(p.obs.size()));
+  std::vector<Vector6d> directions;
+  for (int k = 0; k < 6; ++k) directions.push_back(Vector6d::Unit(k));
+  directions.push_back((Vector6d() << 1, -2, 0.5, 3, 1, -1).finished().normalized());
+  directions.push_back((Vector6d() << -0.3, 0.2, 1, -1, 2, 0.5).finished().normalized());
+  for (const Vector6d& d : directions) {
+    const Vector6d e = 2e-4 * d;  // 0.2 mm or 0.2 mrad
+    const PoseScore s = score_pose(p.obs, p.K, kBf, se3_exp(e) * p.T_true, BaParams{});
+    ASSERT_EQ(s.inliers, int(p.obs.size()));
+    const double expected = e.dot(r.information * e);
+    EXPECT_NEAR(s.cost, expected, 0.02 * expected) << "direction " << d.transpose();
+  }
+}
+
 TEST(MotionBa, RecoversKnownPoseWith30PercentOutliers) {
   const Problem p = make_problem(300, 0.30, 7);
   const Eigen::Isometry3d T0 = perturbed(p.T_true);
