@@ -17,6 +17,7 @@
 #include "core/tracking/mask_source.h"
 #include "core/tracking/motion_ba.h"
 #include "core/tracking/orb_features.h"
+#include "core/tracking/se3.h"
 #include "core/tracking/tracker.h"
 #include "core/tsdf/tsdf_integrate.h"
 
@@ -25,13 +26,13 @@
 
 #include <algorithm>
 #include <memory>
+#include <numbers>
 #include <cstdio>
 #include <vector>
 
 namespace {
 
 using namespace rrg;
-using Vector6d = Eigen::Matrix<double, 6, 1>;
 
 // The PosePrior's e = [ρ; φ] of T T_ref⁻¹.
 Vector6d twist_error(const Eigen::Isometry3d& T, const Eigen::Isometry3d& T_ref) {
@@ -45,10 +46,10 @@ Vector6d twist_error(const Eigen::Isometry3d& T, const Eigen::Isometry3d& T_ref)
 
 struct Stats {
   std::vector<double> nees, translation_mm, rotation_deg;
-  void add(const Vector6d& e, const Eigen::Matrix<double, 6, 6>& info) {
+  void add(const Vector6d& e, const Matrix6d& info) {
     nees.push_back(e.dot(info * e));
     translation_mm.push_back(e.head<3>().norm() * 1e3);
-    rotation_deg.push_back(e.tail<3>().norm() * 180.0 / 3.14159265358979);
+    rotation_deg.push_back(e.tail<3>().norm() * 180.0 / std::numbers::pi);
   }
   static double median(std::vector<double> v) {
     if (v.empty()) return 0.0;
