@@ -34,16 +34,6 @@ namespace {
 
 using namespace rrg;
 
-// The PosePrior's e = [ρ; φ] of T T_ref⁻¹.
-Vector6d twist_error(const Eigen::Isometry3d& T, const Eigen::Isometry3d& T_ref) {
-  const Eigen::Isometry3d D = T * T_ref.inverse();
-  const Eigen::AngleAxisd aa(D.linear());
-  Vector6d e;
-  e.head<3>() = D.translation();
-  e.tail<3>() = aa.angle() * aa.axis();
-  return e;
-}
-
 struct Stats {
   std::vector<double> nees, translation_mm, rotation_deg;
   void add(const Vector6d& e, const Matrix6d& info) {
@@ -122,7 +112,7 @@ int main(int argc, char** argv) {
       const TrackResult r = tracker.track({i, &f.color, &f.depth, &depth}, model, nullptr);
       if (!r.first && r.state == TrackingState::Ok) {
         const double sigma = std::max(double(r.icp.rmse_ref_m), 1e-6);
-        icp.add(twist_error(r.icp.T_wc.cast<double>(), T_gt), r.icp.jtj / (sigma * sigma));
+        icp.add(pose_difference_twist(r.icp.T_wc.cast<double>(), T_gt), r.icp.jtj / (sigma * sigma));
       }
       const MaskImage mask = masks ? masks->mask(i, T_gt.cast<float>()) : MaskImage();
       const OrbFrame features = extract_orb(f.color, f.depth, K, masks ? &mask : nullptr, params.orb);
@@ -131,7 +121,7 @@ int main(int argc, char** argv) {
                                                  r.icp.T_wc, params.orb);
         const auto obs = to_observations(features, matches, params.orb);
         const BaResult ba = optimize_pose(obs, K, params.orb.baseline_fx, r.icp.T_wc.cast<double>(), params.ba);
-        if (ba.inliers >= params.orb.min_inliers) orb.add(twist_error(ba.T_wc, T_gt), ba.information);
+        if (ba.inliers >= params.orb.min_inliers) orb.add(pose_difference_twist(ba.T_wc, T_gt), ba.information);
       }
       if (keyframes.empty() || needs_keyframe(keyframes.back().T_wc, T_gt.cast<float>(), params.keyframes))
         keyframes.add(make_keyframe(keyframe_id++, i, T_gt.cast<float>(), features));

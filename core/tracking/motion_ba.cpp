@@ -56,11 +56,7 @@ Matrix6d adjoint(const Eigen::Isometry3d& T) {
 // T_wc ← T_wc exp(−ξ) = exp(−Ad(T_wc) ξ) T_wc, so ∂e/∂ξ = −Ad(T_wc) to first order.
 void add_prior(const PosePrior& prior, const Eigen::Isometry3d& T_cw, Matrix6d& H, Vector6d& g) {
   const Eigen::Isometry3d T_wc = T_cw.inverse();
-  const Eigen::Isometry3d D = T_wc * prior.T_wc.inverse();
-  const Eigen::AngleAxisd aa(D.linear());
-  Vector6d e;
-  e.head<3>() = D.translation();
-  e.tail<3>() = aa.angle() * aa.axis();
+  const Vector6d e = pose_difference_twist(T_wc, prior.T_wc);
   const Matrix6d A = -adjoint(T_wc);
   H += A.transpose() * prior.information * A;
   g -= A.transpose() * prior.information * e;

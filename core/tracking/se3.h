@@ -44,6 +44,17 @@ inline double rotation_distance(const Eigen::Isometry3d& a, const Eigen::Isometr
   return std::atan2(0.5 * v.norm(), c);
 }
 
+// The pose difference as a world-frame twist, e = [ρ; φ] of D = T T_ref⁻¹ (ρ = D's translation,
+// φ = D's angle-axis): the PosePrior's error (motion_ba.h), T ≈ exp(e) T_ref for small e.
+inline Vector6d pose_difference_twist(const Eigen::Isometry3d& T, const Eigen::Isometry3d& T_ref) {
+  const Eigen::Isometry3d D = T * T_ref.inverse();
+  const Eigen::AngleAxisd aa(D.linear());
+  Vector6d e;
+  e.head<3>() = D.translation();
+  e.tail<3>() = aa.angle() * aa.axis();
+  return e;
+}
+
 // Re-orthonormalises the rotation of a pose accumulated from many float updates.
 inline Eigen::Isometry3d orthonormalized(const Eigen::Isometry3d& T) {
   Eigen::Isometry3d out = T;

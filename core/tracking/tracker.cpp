@@ -187,11 +187,7 @@ TrackResult Tracker::track(const TrackInput& in, ModelSource& model, MaskSource*
       const bool better = at_ba.inliers >= at_icp.inliers && at_ba.cost < at_icp.cost;
       bool consistent = true;
       if (params_.orb.icp_prior_scale > 0) {
-        const Eigen::Isometry3d D = ba.T_wc * T_icp.inverse();
-        const Eigen::AngleAxisd aa(D.linear());
-        Vector6d e;
-        e.head<3>() = D.translation();
-        e.tail<3>() = aa.angle() * aa.axis();
+        const Vector6d e = pose_difference_twist(ba.T_wc, T_icp);
         consistent = e.dot(prior.information * e) <= double(params_.orb.icp_consistency_chi2);
       }
       if (ba.inliers >= params_.orb.min_inliers && plausible && better && consistent) {
