@@ -68,6 +68,7 @@ int main(int argc, char** argv) {
   float voxel = 0.01f, max_depth = 5.0f;
   int max_frames = 0, skip = 1;
   bool synth_masks = false;
+  float orb_depth_range = OrbParams{}.max_depth_range;
   app.add_option("--dataset", dataset_path, "dataset with ground-truth poses")->required();
   app.add_option("--voxel", voxel, "TSDF voxel size, metres");
   app.add_option("--max-depth", max_depth, "ignore depth beyond, metres");
@@ -75,6 +76,10 @@ int main(int argc, char** argv) {
   app.add_option("--skip", skip, "track every N-th frame (larger motion per frame)")->check(CLI::PositiveNumber);
   app.add_flag("--synth-masks", synth_masks,
                "keep ORB off the generator's ground-truth reflection masks (reflection/), as icp+orb+mask does");
+  app.add_option("--orb-depth-range", orb_depth_range,
+                 "a keypoint whose window's depths span more than this fraction of its depth keeps no depth (0 = off)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -82,6 +87,7 @@ int main(int argc, char** argv) {
     const Intrinsics& K = dataset->intrinsics();
     TrackingParams params;
     params.mode = TrackingMode::Icp;  // stage 2 is run here, from the ground-truth keyframes
+    params.orb.max_depth_range = orb_depth_range;
     TsdfParams tsdf;
     tsdf.voxel_size = voxel;
     tsdf.truncation = 4.0f * voxel;

@@ -34,6 +34,7 @@ struct TrackOptions {
   int max_frames = 0, progress = 50;
   bool no_bilateral = false, identity_start = false, fuse_raw = false, no_noise_weighting = false;
   float icp_prior = TrackingParams{}.orb.icp_prior_scale;
+  float orb_depth_range = TrackingParams{}.orb.max_depth_range;
 };
 
 using Clock = std::chrono::steady_clock;
@@ -58,6 +59,7 @@ void run_track(const TrackOptions& o) {
   params.preprocess.bilateral = !o.no_bilateral;
   params.icp.noise_weighting = !o.no_noise_weighting;
   params.orb.icp_prior_scale = o.icp_prior;
+  params.orb.max_depth_range = o.orb_depth_range;
   const Device device = parse_device(o.device);
   const auto dataset = io::open_dataset(o.dataset, o.flags.to_options());
   const auto masks = make_mask_source(o, *dataset, params.mode);
@@ -199,6 +201,10 @@ void register_track_command(CLI::App& app) {
   cmd->add_option("--log", opts->log, "per-frame CSV (state, ICP quality, ORB matches, timings)");
   cmd->add_option("--mesh", opts->mesh, "also write the fused mesh (PLY)");
   cmd->add_option("--icp-prior", opts->icp_prior, "weight s of the ICP pose prior in the ORB bundle adjustment (0 = none)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--orb-depth-range", opts->orb_depth_range,
+                  "a keypoint whose window's depths span more than this fraction of its depth keeps no depth (0 = off)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--no-bilateral", opts->no_bilateral, "skip the bilateral depth filter");

@@ -237,6 +237,8 @@ std::vector<ConfigField> config_fields(SessionConfig& c) {
   t.i("tracking.orb.min_inliers", c.tracking.orb.min_inliers, "BA inliers needed to accept ORB refinement");
   t.f("tracking.orb.icp_prior_scale", c.tracking.orb.icp_prior_scale,
       "s of the ICP prior s JᵀJ/σ² in ORB's bundle adjustment and its consistency gate (0 = none)");
+  t.f("tracking.orb.max_depth_range", c.tracking.orb.max_depth_range,
+      "a keypoint whose window's depths span more than this fraction of its depth keeps no depth (0 = off)");
   t.f("tracking.orb.mask_threshold", c.tracking.orb.mask_threshold, "R^track = mean RGB of C_r > this");
   t.i("tracking.orb.mask_downsample", c.tracking.orb.mask_downsample,
       "render the tracking mask at 1/f of the frame's width and height (1 = full)");

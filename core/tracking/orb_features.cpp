@@ -3,6 +3,7 @@
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -17,6 +18,19 @@ constexpr int kMaskDilatePx = 7;  // half of OpenCV ORB's 31-pixel patch, rounde
 std::string size_text(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
 
 }  // namespace
+
+bool on_depth_edge(const DepthImage& depth, int x, int y, int half, float max_range) {
+  const float z = depth(x, y);
+  float lo = z, hi = z;
+  for (int v = std::max(0, y - half); v <= std::min(depth.height() - 1, y + half); ++v)
+    for (int u = std::max(0, x - half); u <= std::min(depth.width() - 1, x + half); ++u) {
+      const float d = depth(u, v);
+      if (!(d > 0.0f)) continue;  // no measurement: no evidence either way
+      lo = std::min(lo, d);
+      hi = std::max(hi, d);
+    }
+  return hi - lo > max_range * z;
+}
 
 void to_level0_pixels(std::vector<cv::KeyPoint>& keypoints, int width, int height, float scale_factor) {
   for (cv::KeyPoint& kp : keypoints) {
@@ -74,6 +88,11 @@ OrbFrame extract_orb(const ColorImage& color, const DepthImage& depth, const Int
     if (x < 0 || y < 0 || x >= depth.width() || y >= depth.height()) continue;
     const float z = depth(x, y);
     if (!(z >= params.min_depth_m && z <= params.max_depth_m)) continue;
+    if (params.max_depth_range > 0.0f) {
+      // the window a keypoint of level l describes grows as 1.2^l (OpenCV's patch is 31 px on its level)
+      const double s = std::pow(double(params.scale_factor), double(std::max(0, f.keypoints[i].octave)));
+      if (on_depth_edge(depth, x, y, std::max(1, int(std::lround(s))), params.max_depth_range)) continue;
+    }
     f.points_cam[i] = K.unproject(f.keypoints[i].pt.x, f.keypoints[i].pt.y, z);
   }
   return f;

@@ -23,10 +23,16 @@ struct OrbFrame {
 cv::Mat to_gray8(const ColorImage& color);
 
 // ORB on `color`; pixels with exclude(u) != 0 (dilated by half an ORB patch) get no keypoint.
-// Depth (metres, registered to colour) gives each keypoint its point p_c = D(u) K⁻¹[u, 1]ᵀ.
+// Depth (metres, registered to colour) gives each keypoint its point p_c = D(u) K⁻¹[u, 1]ᵀ, unless
+// the keypoint sits on a depth edge (on_depth_edge, OrbParams::max_depth_range): then z = 0.
 // Throws std::invalid_argument when the image, depth, mask and K sizes differ.
 OrbFrame extract_orb(const ColorImage& color, const DepthImage& depth, const Intrinsics& K,
                      const MaskImage* exclude, const OrbParams& params);
+
+// Whether the valid depths in the (2·half + 1)² window around (x, y) span more than max_range ·
+// D(x, y), D(x, y) valid: an occlusion corner or silhouette rather than one surface point. Pixels
+// without depth are no evidence either way.
+bool on_depth_edge(const DepthImage& depth, int x, int y, int half, float max_range);
 
 // OpenCV's ORB reports a keypoint found on pyramid level l at s_l·x_l, s_l = f^l, as if level l's
 // pixel x_l covered level 0 from s_l·x_l. Its levels are resized with pixel centres at x + 0.5 and

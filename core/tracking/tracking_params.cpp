@@ -41,6 +41,7 @@ void TrackingParams::validate() const {
   if (orb.features < 10) fail("orb.features must be >= 10");
   if (!(orb.ratio > 0 && orb.ratio <= 1)) fail("orb.ratio must be in (0, 1]");
   if (!(orb.icp_prior_scale >= 0)) fail("orb.icp_prior_scale must be >= 0");
+  if (!(orb.max_depth_range >= 0)) fail("orb.max_depth_range must be >= 0 (0 = off)");
   if (!(orb.icp_consistency_chi2 > 0)) fail("orb.icp_consistency_chi2 must be > 0");
   if (orb.window_keyframes < 1) fail("orb.window_keyframes must be >= 1");
   if (orb.min_inliers < 6) fail("orb.min_inliers must be >= 6");

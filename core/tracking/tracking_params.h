@@ -52,6 +52,13 @@ struct OrbParams {
   int levels = 8;
   float scale_factor = 1.2f;
   float min_depth_m = 0.1f, max_depth_m = 6.0f;  // keypoints need a valid depth to become map points
+  // A keypoint on a depth discontinuity (an occlusion corner, a silhouette) is no fixed 3D point: the
+  // corner moves along the background as the camera moves, and the depth at its rounded pixel may
+  // be either side. When the valid depths in its window (half-width max(1, round(1.2^octave)) px)
+  // span more than this fraction of its own depth, it keeps no depth: no map point, a monocular
+  // observation. 5 % is above Kinect v1's noise over a window (±2σ_n ≈ 2 % of z at 3 m) plus an 80°
+  // oblique plane across 2 px at f = 256 (docs/tracking.md "Keypoints on depth edges"). 0 = off.
+  float max_depth_range = 0.05f;
   float ratio = 0.8f;             // Lowe ratio test (best / second best Hamming distance)
   int max_hamming = 64;           // descriptor distance limit (ORB-SLAM2 TH_HIGH = 100, TH_LOW = 50)
   float search_radius_px = 12.0f; // guided matching: keypoint within this of the projected map point

@@ -1,4 +1,5 @@
-// ORB keypoints in level-0 pixel coordinates at every pyramid level (to_level0_pixels).
+// ORB keypoints in level-0 pixel coordinates at every pyramid level (to_level0_pixels), and no depth
+// for keypoints on depth edges (on_depth_edge).
 #include "core/tracking/orb_features.h"
 
 #include <gtest/gtest.h>
@@ -89,6 +90,80 @@ TEST(OrbFeatures, LevelCoordinatesMapToLevelZeroPixelCentres) {
   EXPECT_FLOAT_EQ(kps[1].pt.y, 34.0f);
   EXPECT_NEAR(kps[2].pt.x, 0.5 * 320.0 / 267.0 - 0.5, 1e-5);
   EXPECT_NEAR(kps[2].pt.y, 0.5 * 240.0 / 200.0 - 0.5, 1e-5);
+}
+
+// A step in depth down the middle of a textured image (2 m left of x = 319.5, 3 m right of it):
+// every keypoint whose window (half-width max(1, round(1.2^octave)) around its rounded pixel)
+// reaches across the step keeps no depth, every other keeps its side's. With the test off
+// (max_depth_range = 0) the keypoints across the step take whichever side their pixel is on.
+TEST(OrbFeatures, KeypointsOnADepthEdgeKeepNoDepth) {
+  const int W = 640, H = 480, step = 320;
+  const Intrinsics K{500.0f, 500.0f, 319.5f, 239.5f, W, H};
+  DepthImage depth(W, H);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) depth(x, y) = x < step ? 2.0f : 3.0f;
+  // two textures meet at x = step, as foreground and background do at an occlusion boundary: the
+  // rectangles' edges end there in corners
+  ColorImage img = rectangles(W, H, 11);
+  const ColorImage right = rectangles(W, H, 12);
+  for (int y = 0; y < H; ++y)
+    for (int x = step; x < W; ++x) img(x, y) = right(x, y);
+  OrbParams params;
+  ASSERT_FLOAT_EQ(params.max_depth_range, 0.05f);
+  const OrbFrame f = extract_orb(img, depth, K, nullptr, params);
+  OrbParams off = params;
+  off.max_depth_range = 0.0f;
+  const OrbFrame g = extract_orb(img, depth, K, nullptr, off);
+  ASSERT_EQ(f.keypoints.size(), g.keypoints.size());
+  int across = 0, kept = 0;
+  for (size_t i = 0; i < f.keypoints.size(); ++i) {
+    const cv::KeyPoint& kp = f.keypoints[i];
+    const int x = int(std::lround(kp.pt.x));
+    const int half = std::max(1, int(std::lround(std::pow(1.2, double(kp.octave)))));
+    const bool straddles = std::max(0, x - half) < step && std::min(W - 1, x + half) >= step;
+    const float side = x < step ? 2.0f : 3.0f;
+    if (straddles) {
+      ++across;
+      EXPECT_EQ(f.points_cam[i].z(), 0.0f) << "keypoint at x = " << kp.pt.x << ", octave " << kp.octave;
+      EXPECT_EQ(g.points_cam[i].z(), side) << "with the test off, keypoint at x = " << kp.pt.x;
+    } else {
+      ++kept;
+      EXPECT_EQ(f.points_cam[i].z(), side) << "keypoint at x = " << kp.pt.x << ", octave " << kp.octave;
+    }
+  }
+  EXPECT_GE(across, 10) << "too few keypoints on the edge to test";
+  EXPECT_GE(kept, 200);
+}
+
+// What is not an edge: a plane 80° oblique to the view at f = 256 (depth changes by z·tan 80° / f,
+// 2.2 % of z a pixel, across the 3x3 window of level 0) and a fronto-parallel plane at 3 m with
+// Kinect v1's noise at ±2σ_n (σ_n ≈ 1.4 cm there) in a checkerboard; and what is: the same plane
+// at 85° (4.5 % a pixel), and a 1 cm step on a plane 10 cm away.
+TEST(OrbFeatures, DepthEdgeTestKnowsAnEdgeFromASteepPlaneAndNoise) {
+  const int W = 320, H = 240;
+  const float f = 256.0f, cx = 159.5f, z0 = 3.0f;
+  auto oblique = [&](double deg) {
+    DepthImage d(W, H);
+    const double t = std::tan(deg * std::acos(-1.0) / 180.0);
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) d(x, y) = float(z0 / (1.0 - t * (double(x) - cx) / f));
+    return d;
+  };
+  EXPECT_FALSE(on_depth_edge(oblique(80.0), 160, 120, 1, 0.05f));
+  EXPECT_TRUE(on_depth_edge(oblique(85.0), 160, 120, 1, 0.05f));
+  const float sigma = 0.0012f + 0.0019f * (z0 - 0.4f) * (z0 - 0.4f);
+  DepthImage noisy(W, H);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) noisy(x, y) = z0 + ((x + y) % 2 ? 2.0f : -2.0f) * sigma;
+  EXPECT_FALSE(on_depth_edge(noisy, 100, 100, 3, 0.05f));
+  DepthImage near(W, H, 0.10f);
+  for (int y = 0; y < H; ++y) near(100, y) = 0.11f;
+  EXPECT_TRUE(on_depth_edge(near, 101, 50, 1, 0.05f));
+  EXPECT_FALSE(on_depth_edge(near, 102, 50, 0, 0.05f));
+  // pixels without depth are no evidence: a hole next to the keypoint is not an edge
+  DepthImage holes(W, H, 2.0f);
+  holes(51, 50) = 0.0f;
+  EXPECT_FALSE(on_depth_edge(holes, 50, 50, 1, 0.05f));
 }
 
 }  // namespace
