@@ -41,7 +41,7 @@ kernel::IcpSystem reduce_icp_system(const VertexNormalMaps& source, const IcpMod
                        model.normals->view(), model.K, T_ref_cw.linear(), T_ref_cw.translation(),
                        T_wc.linear(), T_wc.translation(), params.max_distance_m,
                        float(std::cos(params.max_normal_angle_deg * std::numbers::pi / 180.0)),
-                       params.huber_delta_m};
+                       params.huber_delta_m, DepthNoiseModel{}, 0.0f};  // noise weighting off unless asked
   if (params.noise_weighting) {
     args.noise = params.noise;
     args.sigma_ref = params.noise.sigma(params.noise_reference_depth_m);
