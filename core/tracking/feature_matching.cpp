@@ -99,7 +99,7 @@ std::vector<FeatureMatch> match_by_projection(const OrbFrame& frame, const std::
       if (uv.x() < 0 || uv.y() < 0 || uv.x() > K.width - 1 || uv.y() > K.height - 1) continue;
       const uint8_t* d = kf->descriptors.ptr<uint8_t>(int(j));
       const int octave = kf->keypoints[j].octave;
-      const float radius = r0 * std::pow(params.scale_factor, float(std::max(0, octave)));
+      const float radius = r0 * float(level_scale(params.scale_factor, octave));
       int best = std::numeric_limits<int>::max(), second = best, best_i = -1;
       grid.for_each_near(uv.x(), uv.y(), radius, [&](int i) {
         const cv::KeyPoint& kp = frame.keypoints[size_t(i)];
@@ -164,7 +164,7 @@ std::vector<BaObservation> to_observations(const OrbFrame& frame, const std::vec
     const float z = frame.points_cam[size_t(m.keypoint)].z();
     if (z > 0.0f) o.u_right = double(kp.pt.x) - double(params.baseline_fx) / double(z);
     if (o.u_right < 0.0) o.u_right = -1.0;  // off the virtual right image: monocular
-    const double s = std::pow(double(params.scale_factor), double(std::max(0, kp.octave)));
+    const double s = level_scale(params.scale_factor, kp.octave);
     o.inv_sigma2 = 1.0 / (s * s);
     obs.push_back(o);
   }

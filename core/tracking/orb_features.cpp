@@ -37,7 +37,7 @@ void to_level0_pixels(std::vector<cv::KeyPoint>& keypoints, int width, int heigh
     if (kp.octave <= 0) continue;
     // OpenCV's level l: s_l = (float) f^l, size (cvRound(W / s_l), cvRound(H / s_l)), each level
     // resized from the one before with pixel centres at x + 0.5, then pt = s_l x_l.
-    const float s = float(std::pow(double(scale_factor), double(kp.octave)));
+    const float s = float(level_scale(scale_factor, kp.octave));
     const int wl = cvRound(float(width) / s), hl = cvRound(float(height) / s);
     const float xl = kp.pt.x / s, yl = kp.pt.y / s;
     kp.pt.x = (xl + 0.5f) * (float(width) / float(wl)) - 0.5f;
@@ -90,8 +90,8 @@ OrbFrame extract_orb(const ColorImage& color, const DepthImage& depth, const Int
     if (!(z >= params.min_depth_m && z <= params.max_depth_m)) continue;
     if (params.max_depth_range > 0.0f) {
       // the window a keypoint of level l describes grows as 1.2^l (OpenCV's patch is 31 px on its level)
-      const double s = std::pow(double(params.scale_factor), double(std::max(0, f.keypoints[i].octave)));
-      if (on_depth_edge(depth, x, y, std::max(1, int(std::lround(s))), params.max_depth_range)) continue;
+      const int half = std::max(1, int(std::lround(level_scale(params.scale_factor, f.keypoints[i].octave))));
+      if (on_depth_edge(depth, x, y, half, params.max_depth_range)) continue;
     }
     f.points_cam[i] = K.unproject(f.keypoints[i].pt.x, f.keypoints[i].pt.y, z);
   }

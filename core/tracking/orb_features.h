@@ -9,6 +9,8 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 namespace rrg {
@@ -41,6 +43,12 @@ bool on_depth_edge(const DepthImage& depth, int x, int y, int half, float max_ra
 // in every frame, so a point seen at different levels in two frames moves. This maps OpenCV's
 // coordinates (octave ≥ 1) to level-0 pixel centres in place; extract_orb applies it.
 void to_level0_pixels(std::vector<cv::KeyPoint>& keypoints, int width, int height, float scale_factor);
+
+// s_l = f^l of pyramid level l = max(0, octave) (OpenCV's layer scale, computed in double as OpenCV
+// does): the keypoint's patch, search radius and pixel noise all grow with it.
+inline double level_scale(float scale_factor, int octave) {
+  return std::pow(double(scale_factor), double(std::max(0, octave)));
+}
 
 // Hamming distance of two 32-byte ORB descriptors.
 int hamming_distance(const uint8_t* a, const uint8_t* b);
