@@ -63,6 +63,7 @@ void LossWeights::validate() const {
   check(lambda_ssim, "lambda_ssim", 1.0f);
   check(lambda_depth, "lambda_depth", 1e6f);
   check(lambda_sobel, "lambda_sobel", 1e6f);
+  check(lambda_reflective_base, "lambda_reflective_base", 1e6f);
 }
 
 float l1_loss(const DeviceImage<Color>& x, const DeviceImage<Color>& y, DeviceImage<Color>* v_x, float weight) {
@@ -116,8 +117,24 @@ float sobel_l1_loss(const DeviceImage<Color>& x, DeviceImage<Color>* v_x, float 
   return r;
 }
 
+float reflective_base_prior(const DeviceImage<Color>& C_b, const DeviceImage<float>& R, DeviceImage<Color>* v_C,
+                            DeviceImage<Color>* v_C_r, float weight) {
+  check_same(C_b, R, "reflective_base_prior");
+  if (bool(v_C) != bool(v_C_r))
+    throw std::invalid_argument("reflective_base_prior: v_C and v_C_r are both given or both null");
+  if (v_C) {
+    check_same(C_b, *v_C, "reflective_base_prior (v_C)");
+    check_same(C_b, *v_C_r, "reflective_base_prior (v_C_r)");
+  }
+  float r = 0;
+  RRG_DISPATCH(C_b.device(),
+               r = kernel::reflective_base_prior_cpu<float>(flat(C_b), flat(R), flat_grad(v_C), flat_grad(v_C_r), weight),
+               r = kernel::reflective_base_prior_cuda(flat(C_b), flat(R), flat_grad(v_C), flat_grad(v_C_r), weight));
+  return r;
+}
+
 LossValues mapping_loss(const DeviceImage<Color>& C, const DeviceImage<Color>& C_gt, const DeviceImage<float>& D_b,
-                        const DeviceImage<float>& D_gt, const DeviceImage<Color>* C_r, const LossWeights& w,
+                        const DeviceImage<float>& D_gt, const ReflectionImages* refl, const LossWeights& w,
                         DeviceImage<Color>& v_C, DeviceImage<float>& v_D_b, DeviceImage<Color>& v_C_r,
                         LossScratch& scratch) {
   w.validate();
@@ -129,14 +146,18 @@ LossValues mapping_loss(const DeviceImage<Color>& C, const DeviceImage<Color>& C
   L.l1 = l1_loss(C, C_gt, &v_C, 1.0f - w.lambda_ssim);
   L.ssim = ssim(C, C_gt, &v_C, -w.lambda_ssim, scratch.ssim);  // ∂(λ(1 − SSIM)) = −λ ∂SSIM
   L.depth_l1 = depth_l1_loss(D_b, D_gt, &v_D_b, w.lambda_depth);
-  if (C_r && w.lambda_sobel > 0.0f) {
+  if (refl && (w.lambda_sobel > 0.0f || w.lambda_reflective_base > 0.0f)) {
+    check_same(C, refl->C_r, "mapping_loss (C, C_r)");
     zero_like(v_C_r, C.width(), C.height(), dev);
-    L.sobel = sobel_l1_loss(*C_r, &v_C_r, w.lambda_sobel, scratch.sobel, scratch.sobel_values);
+    if (w.lambda_sobel > 0.0f)
+      L.sobel = sobel_l1_loss(refl->C_r, &v_C_r, w.lambda_sobel, scratch.sobel, scratch.sobel_values);
+    if (w.lambda_reflective_base > 0.0f)
+      L.reflective_base = reflective_base_prior(refl->C_b, refl->R, &v_C, &v_C_r, w.lambda_reflective_base);
   } else {
     v_C_r = DeviceImage<Color>();
   }
   L.total = (1.0 - w.lambda_ssim) * L.l1 + w.lambda_ssim * (1.0 - L.ssim) + w.lambda_depth * L.depth_l1 +
-            w.lambda_sobel * L.sobel;
+            w.lambda_sobel * L.sobel + w.lambda_reflective_base * L.reflective_base;
   return L;
 }
 

@@ -17,6 +17,10 @@ template <class T>
 T depth_l1_loss_cpu(Span<const T> d, Span<const T> d_gt, Span<T> v_d, T weight) {
   return depth_l1_loss(CpuBackend{}, d, d_gt, v_d, weight);
 }
+template <class T>
+T reflective_base_prior_cpu(Span<const T> C_b, Span<const T> R, Span<T> v_C, Span<T> v_C_r, T weight) {
+  return reflective_base_prior(CpuBackend{}, C_b, R, v_C, v_C_r, weight);
+}
 // Streamed over rows (ssim_rows_cpu.h; the same floats as the separate passes) whenever its bands
 // fit the scratch ssim() asks for, which is all but images a few rows tall.
 template <class T>
@@ -44,6 +48,7 @@ T sobel_l1_loss_cpu(int w, int h, Span<const T> x, Span<T> v_x, T weight, Span<i
 #define RRG_LOSSES_INSTANTIATE(T)                                                                  \
   template T l1_loss_cpu<T>(Span<const T>, Span<const T>, Span<T>, T);                             \
   template T depth_l1_loss_cpu<T>(Span<const T>, Span<const T>, Span<T>, T);                       \
+  template T reflective_base_prior_cpu<T>(Span<const T>, Span<const T>, Span<T>, Span<T>, T);      \
   template T ssim_cpu<T>(int, int, Span<const T>, Span<const T>, Span<T>, T, SsimWindow<T>, Span<T>); \
   template T sobel_l1_loss_cpu<T>(int, int, Span<const T>, Span<T>, T, Span<int8_t>, Span<T>);
 RRG_LOSSES_INSTANTIATE(float)

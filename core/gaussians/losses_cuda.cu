@@ -14,6 +14,12 @@ float depth_l1_loss_cuda(Span<const float> d, Span<const float> d_gt, Span<float
   RRG_CUDA_CHECK(cudaStreamSynchronize(nullptr));
   return r;
 }
+float reflective_base_prior_cuda(Span<const float> C_b, Span<const float> R, Span<float> v_C, Span<float> v_C_r,
+                                 float weight) {
+  const float r = reflective_base_prior(CudaBackend{}, C_b, R, v_C, v_C_r, weight);
+  RRG_CUDA_CHECK(cudaStreamSynchronize(nullptr));
+  return r;
+}
 float ssim_cuda(int w, int h, Span<const float> x, Span<const float> y, Span<float> v_x, float weight,
                 SsimWindow<float> win, Span<float> scratch) {
   const float r = ssim(CudaBackend{}, w, h, x, y, v_x, weight, win, scratch);

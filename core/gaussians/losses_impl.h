@@ -34,6 +34,26 @@ T l1_loss(Backend be, Span<const T> x, Span<const T> y, Span<T> v_x, T weight) {
   return total / T(n);
 }
 
+// L_rb = mean over pixels and channels of R · C_b (ours, docs/mapping.md "The base under a
+// reflection"), R the 0/1 reflection mask. Its gradient reaches C_b only: the renderer hands v_C to
+// C_b and R v_C (+ v_C_r) to C_r (C = C_b + R C_r), so adding s R to v_C and −s R to v_C_r gives
+// C_b the gradient s R and C_r s (R² − R) = 0, exact for R in {0, 1}.
+template <class Backend, class T>
+T reflective_base_prior(Backend be, Span<const T> C_b, Span<const T> R, Span<T> v_C, Span<T> v_C_r, T weight) {
+  const int64_t n = C_b.size;  // pixels × 3
+  const T total = parallel_reduce(
+      be, n, T(0), [=] RRG_HD(int64_t i) { return R[i / 3] * C_b[i]; }, [] RRG_HD(T a, T b) { return a + b; });
+  if (!v_C.empty()) {
+    const T s = weight / T(n);
+    parallel_for(be, n, [=] RRG_HD(int64_t i) {
+      const T g = s * R[i / 3];
+      v_C[i] += g;
+      v_C_r[i] -= g;
+    });
+  }
+  return total / T(n);
+}
+
 // L_depth = mean over pixels with D_gt > 0 of |D − D_gt| (0 when no pixel is valid).
 template <class Backend, class T>
 T depth_l1_loss(Backend be, Span<const T> d, Span<const T> d_gt, Span<T> v_d, T weight) {
@@ -276,6 +296,8 @@ T l1_loss_cpu(Span<const T> x, Span<const T> y, Span<T> v_x, T weight);
 template <class T>
 T depth_l1_loss_cpu(Span<const T> d, Span<const T> d_gt, Span<T> v_d, T weight);
 template <class T>
+T reflective_base_prior_cpu(Span<const T> C_b, Span<const T> R, Span<T> v_C, Span<T> v_C_r, T weight);
+template <class T>
 T ssim_cpu(int w, int h, Span<const T> x, Span<const T> y, Span<T> v_x, T weight, SsimWindow<T> win,
            Span<T> scratch);
 // values: w h 3 scalars of working memory (a buffer of its own is made when it is smaller).
@@ -284,6 +306,8 @@ T sobel_l1_loss_cpu(int w, int h, Span<const T> x, Span<T> v_x, T weight, Span<i
 
 float l1_loss_cuda(Span<const float> x, Span<const float> y, Span<float> v_x, float weight);
 float depth_l1_loss_cuda(Span<const float> d, Span<const float> d_gt, Span<float> v_d, float weight);
+float reflective_base_prior_cuda(Span<const float> C_b, Span<const float> R, Span<float> v_C, Span<float> v_C_r,
+                                 float weight);
 float ssim_cuda(int w, int h, Span<const float> x, Span<const float> y, Span<float> v_x, float weight,
                 SsimWindow<float> win, Span<float> scratch);
 float sobel_l1_loss_cuda(int w, int h, Span<const float> x, Span<float> v_x, float weight, Span<int8_t> signs);

@@ -376,8 +376,12 @@ MappingStats GaussianMapper::run(std::shared_ptr<Prepared> prepared, const Mappi
     renderer_.render({K_, f.frame->T_wc}, base_, pass3 ? refl_ : no_reflection_, f.rc, out);
     st.optimise.render += ms_since(tp);
     tp = Clock::now();
-    const bool with_refl = reflections && refl_.size() > 0;
-    const LossValues L = mapping_loss(out.C, f.C_gt, out.D_b, f.D_gt, with_refl ? &out.C_r : nullptr, lw, up.v_C,
+    // The reflection terms where pass 3 ran: without it C_r = 0 and no reflection Gaussian gets a
+    // gradient, so the Sobel term has nothing to act on and λ_rb would darken C_b with nothing to
+    // take its place.
+    const ReflectionImages refl_images{out.C_r, out.C_b, f.rc.R};
+    const bool with_refl = reflections && pass3;
+    const LossValues L = mapping_loss(out.C, f.C_gt, out.D_b, f.D_gt, with_refl ? &refl_images : nullptr, lw, up.v_C,
                                       up.v_D_b, up.v_C_r, loss_scratch_);
     loss_sum += L.total;
     st.optimise.loss += ms_since(tp);

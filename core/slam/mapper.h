@@ -53,6 +53,7 @@ struct MapperParams {            // paper defaults (DESIGN.md §5); validate() t
   float lambda_ssim = 0.2f;      // λ of L_color
   float lambda_depth = 0.2f;     // λ_d
   float lambda_sobel = 0.05f;    // λ_g
+  float lambda_reflective_base = 0.3f;  // λ_rb (ours, LossWeights)
   int sh_degree = 3;             // SH degree of new Gaussians (the supplement's lr_SHrest implies > 0)
   uint64_t seed = 0;             // keyframe sampling, frame order, densification sampling
   bool reflections = true;       // false = base only (the --no-reflections ablation)
@@ -64,7 +65,7 @@ struct MapperParams {            // paper defaults (DESIGN.md §5); validate() t
   AdamParams adam_reflection{AdamLearningRates::reflection()};
   RenderParams render;           // renderer settings (ε = TSDF truncation, ...)
   void validate() const;
-  LossWeights loss_weights() const { return {lambda_ssim, lambda_depth, lambda_sobel}; }
+  LossWeights loss_weights() const { return {lambda_ssim, lambda_depth, lambda_sobel, lambda_reflective_base}; }
 };
 
 // Adds the named fields of MapperParams to a session's configuration table (as "mapping.<name>").

@@ -29,6 +29,8 @@ void add_mapper_config_fields(ConfigTable& t, MapperParams& p) {
   t.f("lambda_ssim", p.lambda_ssim, "λ: weight of 1 − SSIM in L_color");
   t.f("lambda_depth", p.lambda_depth, "λ_d: depth L1 weight");
   t.f("lambda_sobel", p.lambda_sobel, "λ_g: ‖Sobel(C_r)‖₁ weight");
+  t.f("lambda_reflective_base", p.lambda_reflective_base,
+      "λ_rb (ours): weight of mean(R·C_b), the base under a reflection (0 = the paper's loss)");
   t.i("sh_degree", p.sh_degree, "SH degree of the Gaussians (0-3)");
   t.u64("seed", p.seed, "seed of keyframe sampling and densification");
   t.b("reflections", p.reflections, "reflection Gaussians (false = base only)");

@@ -233,21 +233,30 @@ TEST(Losses, FloatApiMatchesDoubleAndDevicesAgree) {
   const double dl = kernel::depth_l1_loss_cpu<double>(cs(dd), cs(gtd), ms(vD), 0.2);
   std::vector<int8_t> signs(size_t(W) * H * 6);
   const double sb = kernel::sobel_l1_loss_cpu<double>(W, H, cs(rd), ms(vR), 0.05, {signs.data(), int64_t(signs.size())});
-  const double total = 0.8 * l1 + 0.2 * (1 - ss) + 0.2 * dl + 0.05 * sb;
+  // λ_rb's term: C_b random, R a 0 / 1 mask with both values
+  const std::vector<double> bd = random_image(W, H, 3, 13);
+  std::vector<double> md(size_t(W) * H);
+  for (size_t i = 0; i < md.size(); ++i) md[i] = (i * 7919 % 5) < 3 ? 1.0 : 0.0;
+  const double rb = kernel::reflective_base_prior_cpu<double>(cs(bd), cs(md), ms(vC), ms(vR), 0.3);
+  const double total = 0.8 * l1 + 0.2 * (1 - ss) + 0.2 * dl + 0.05 * sb + 0.3 * rb;
 
-  const ColorImage X = to_color(xd, W, H), Y = to_color(yd, W, H), Rr = to_color(rd, W, H);
+  const ColorImage X = to_color(xd, W, H), Y = to_color(yd, W, H), Rr = to_color(rd, W, H), B = to_color(bd, W, H);
+  Image<float> M(W, H);
+  for (size_t i = 0; i < M.size(); ++i) M[i] = float(md[i]);
   DepthImage D(W, H), G(W, H);
   for (size_t i = 0; i < D.size(); ++i) D[i] = float(dd[i]), G[i] = float(gtd[i]);
   const auto got = test::expect_device_parity<double>(
       [&](const Device& dev) {
         const auto C = DeviceImage<Color>::from_host(X, dev), Cgt = DeviceImage<Color>::from_host(Y, dev);
-        const auto Cr = DeviceImage<Color>::from_host(Rr, dev);
+        const auto Cr = DeviceImage<Color>::from_host(Rr, dev), Cb = DeviceImage<Color>::from_host(B, dev);
+        const auto Rm = DeviceImage<float>::from_host(M, dev);
         const auto Db = DeviceImage<float>::from_host(D, dev), Dgt = DeviceImage<float>::from_host(G, dev);
         DeviceImage<Color> v_C, v_Cr;
         DeviceImage<float> v_D;
         LossScratch sc;
-        const LossValues L = mapping_loss(C, Cgt, Db, Dgt, &Cr, LossWeights{}, v_C, v_D, v_Cr, sc);
-        std::vector<double> out = {L.total, L.l1, L.ssim, L.depth_l1, L.sobel};
+        const ReflectionImages refl{Cr, Cb, Rm};
+        const LossValues L = mapping_loss(C, Cgt, Db, Dgt, &refl, LossWeights{}, v_C, v_D, v_Cr, sc);
+        std::vector<double> out = {L.total, L.l1, L.ssim, L.depth_l1, L.sobel, L.reflective_base};
         const ColorImage hC = v_C.to_host(), hCr = v_Cr.to_host();
         const DepthImage hD = v_D.to_host();
         for (const Color& c : hC.pixels()) out.insert(out.end(), {c.x(), c.y(), c.z()});
@@ -261,7 +270,9 @@ TEST(Losses, FloatApiMatchesDoubleAndDevicesAgree) {
   EXPECT_NEAR(got[2], ss, 1e-5);
   EXPECT_NEAR(got[3], dl, 1e-6);
   EXPECT_NEAR(got[4], sb, 1e-5);
-  size_t k = 5;
+  EXPECT_NEAR(got[5], rb, 1e-6);
+  EXPECT_GT(rb, 0.1);  // the term is on in the default weights and sees the mask
+  size_t k = 6;
   double max_g = 0, max_err = 0;
   for (const auto* ref : {&vC, &vD, &vR})
     for (double r : *ref) {
@@ -270,6 +281,36 @@ TEST(Losses, FloatApiMatchesDoubleAndDevicesAgree) {
     }
   EXPECT_EQ(k, got.size());
   EXPECT_LT(max_err, 1e-4 * max_g);
+}
+
+// λ_rb's term by hand: C_b = 0.4 everywhere, R = 1 on the left half of a 4x2 image: mean(R · C_b)
+// = 0.2; its gradient goes into v_C as +s R and into v_C_r as −s R (s = weight / 24), which the
+// renderer turns into s R on C_b and nothing on C_r (RenderGradient.ReflectiveBasePriorReachesTheBaseOnly).
+TEST(Losses, ReflectiveBasePriorKnownAnswer) {
+  ColorImage cb(4, 2);
+  Image<float> r(4, 2);
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 4; ++x) cb(x, y) = Color::Constant(0.4f), r(x, y) = x < 2 ? 1.0f : 0.0f;
+  const auto Cb = DeviceImage<Color>::from_host(cb, Device::cpu());
+  const auto R = DeviceImage<float>::from_host(r, Device::cpu());
+  auto v_C = DeviceImage<Color>::from_host(ColorImage(4, 2, Color::Constant(0.5f)), Device::cpu());
+  auto v_Cr = DeviceImage<Color>::from_host(ColorImage(4, 2, Color::Constant(0.25f)), Device::cpu());
+  EXPECT_NEAR(reflective_base_prior(Cb, R, nullptr, nullptr, 0.3f), 0.2f, 1e-7f);
+  EXPECT_NEAR(reflective_base_prior(Cb, R, &v_C, &v_Cr, 0.3f), 0.2f, 1e-7f);
+  const ColorImage hC = v_C.to_host(), hCr = v_Cr.to_host();
+  const float s = 0.3f / 24.0f;
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 4; ++x)
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_FLOAT_EQ(hC(x, y)[c], x < 2 ? 0.5f + s : 0.5f);  // added to what the other terms left
+        EXPECT_FLOAT_EQ(hCr(x, y)[c], x < 2 ? 0.25f - s : 0.25f);
+      }
+  EXPECT_THROW(reflective_base_prior(Cb, R, &v_C, nullptr, 0.3f), std::invalid_argument);
+  const auto R_small = DeviceImage<float>::from_host(Image<float>(3, 2), Device::cpu());
+  EXPECT_THROW(reflective_base_prior(Cb, R_small, nullptr, nullptr, 0.3f), std::invalid_argument);
+  LossWeights w;
+  w.lambda_reflective_base = -0.1f;
+  EXPECT_THROW(w.validate(), std::invalid_argument);
 }
 
 TEST(Losses, RejectsMismatchedImages) {

@@ -1,11 +1,13 @@
 // Backward passes of pass 2 and pass 3 against central finite differences of the double-precision
 // reference (render_scene.h), per parameter type of each set; CPU/CUDA parity of the gradients.
+#include "core/gaussians/losses.h"
 #include "core/render/renderer.h"
 #include "tests/render/render_scene.h"
 #include "tests/support/parity.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <iostream>
@@ -166,6 +168,67 @@ TEST_P(RenderGradient, EveryParameterTypeOfBothSetsMatchesFiniteDifferences) {
                 << name(param) << ": max rel err " << r.max_rel << " (" << r.n << " scalars, " << r.at_threshold
                 << " at a threshold, max |g| " << r.max_abs_fd << ")\n";
     }
+}
+
+// λ_rb (core/gaussians/losses.h) reaches the renderer as v_C += s R, v_C_r −= s R. Through the real
+// backward that must be the gradient of λ mean(R · C_b) alone: no reflection Gaussian gets a gradient,
+// and the base's match central differences of that loss computed from the reference's C_b.
+TEST(RenderGradient, ReflectiveBasePriorReachesTheBaseOnly) {
+  const SmallScene s = small_scene(11);
+  const int w = s.camera.K.width, h = s.camera.K.height;
+  const float lambda = 0.3f;
+  auto v_C = DeviceImage<Color>::from_host(ColorImage(w, h, Color::Zero()), Device::cpu());
+  auto v_Cr = DeviceImage<Color>::from_host(ColorImage(w, h, Color::Zero()), Device::cpu());
+  const auto R = DeviceImage<float>::from_host(s.raycast.R, Device::cpu());
+  const auto Cb = DeviceImage<Color>::from_host(ColorImage(w, h, Color::Zero()), Device::cpu());  // value only
+  reflective_base_prior(Cb, R, &v_C, &v_Cr, lambda);
+  const HostUpstream up{v_C.to_host(), v_Cr.to_host(), DepthImage(w, h, 0.0f)};
+  RenderParams p;
+  const Grads a = analytic(s, up, p, Device::cpu());
+
+  double refl_max = 0;
+  for (size_t i = 0; i < a.refl.size(); ++i)
+    refl_max = std::max({refl_max, double(a.refl.means[i].cwiseAbs().maxCoeff()),
+                         double(a.refl.log_scales[i].cwiseAbs().maxCoeff()), double(a.refl.quats[i].cwiseAbs().maxCoeff()),
+                         double(std::abs(a.refl.logit_opacities[i]))});
+  for (const auto& c : a.refl.sh) refl_max = std::max(refl_max, double(c.cwiseAbs().maxCoeff()));
+  ASSERT_GT(a.refl.size(), 0u);
+  EXPECT_EQ(refl_max, 0.0) << "C_r must get no gradient from the prior";
+
+  GaussiansD base = GaussiansD::from(s.base), refl = GaussiansD::from(s.refl);
+  size_t ones = 0;
+  for (float r : s.raycast.R.pixels()) ones += r == 1.0f;
+  ASSERT_GT(ones, 0u);
+  ASSERT_LT(ones, s.raycast.R.size());
+  const auto loss = [&] {
+    const ReferenceOutputs out = render_reference(s.camera, base, refl, s.raycast, p);
+    double L = 0;
+    for (size_t u = 0; u < out.C_b.size(); ++u) L += double(s.raycast.R[u]) * out.C_b[u].sum();
+    return double(lambda) * L / (3.0 * w * h);
+  };
+  for (Param param : {Param::Mean, Param::LogScale, Param::Opacity, Param::Sh}) {
+    SCOPED_TRACE(name(param));
+    std::vector<double*> x;
+    std::vector<double> grad;
+    scalars(base, a.base, param, x, grad);
+    const double hstep = 1e-6;
+    std::vector<double> fd(x.size());
+    double max_fd = 0;
+    for (size_t j = 0; j < x.size(); ++j) {
+      const double x0 = *x[j];
+      *x[j] = x0 + hstep;
+      const double lp = loss();
+      *x[j] = x0 - hstep;
+      const double lm = loss();
+      *x[j] = x0;
+      fd[j] = (lp - lm) / (2 * hstep);
+      max_fd = std::max(max_fd, std::abs(fd[j]));
+    }
+    EXPECT_GT(max_fd, 1e-5) << "the prior must move this parameter";
+    size_t off = 0;
+    for (size_t j = 0; j < x.size(); ++j) off += std::abs(grad[j] - fd[j]) > 2e-3 * max_fd;
+    EXPECT_LE(off, std::max<size_t>(1, x.size() / 50)) << "scalars off their finite difference (thresholds allowed 2%)";
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, RenderGradient,
