@@ -25,6 +25,22 @@ RRG_HD inline int floor_to_int(float x) {
 #endif
 }
 
+// Index of the lowest / highest set bit of x != 0 (tzcnt / lzcnt on the host, one instruction on CUDA).
+RRG_HD inline int lowest_bit(uint32_t x) {
+#if defined(__CUDA_ARCH__)
+  return __ffs(int(x)) - 1;
+#else
+  return __builtin_ctz(x);
+#endif
+}
+RRG_HD inline int highest_bit(uint32_t x) {
+#if defined(__CUDA_ARCH__)
+  return 31 - __clz(int(x));
+#else
+  return 31 - __builtin_clz(x);
+#endif
+}
+
 // min / max of numbers that are never NaN (minss / maxss on the host).
 RRG_HD inline float min_f(float a, float b) { return a < b ? a : b; }
 RRG_HD inline float max_f(float a, float b) { return a > b ? a : b; }

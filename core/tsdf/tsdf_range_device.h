@@ -1,13 +1,22 @@
 #pragma once
-// The coarse range image of the raycast (InfiniTAM's min/max depth image): every resident block is
-// projected into a grid of kRangeTile² pixel tiles, and each tile keeps the nearest and farthest
-// depth at which a block it overlaps can be met. A ray then marches only within its tile's
-// [near, far], and a tile no block projects into is a miss without any volume lookup.
+// The coarse range image of the raycast (InfiniTAM's min/max depth image): boxes where a ray can
+// end on a hit are projected into a grid of kRangeTile² pixel tiles, and each tile keeps the nearest
+// and farthest depth of the boxes it overlaps. A ray then marches only within its tile's
+// [near, far], and a tile no box projects into is a miss without any volume lookup.
 //
-// Conservative by construction: a trilinear sample at p needs its lower corner voxel floor(p / s) in
-// an allocated block b, so every valid sample lies in the box [8b, 8b + 8] · s of some block; z is
-// linear, so the depth of a ray point in that box lies between the depths of the box's corners, and
-// the pixel lies inside the bounding rectangle of their projections.
+// The boxes: a march ends on a hit at a valid sample with f ≤ 0 after one with f > 0. The trilinear
+// value is a convex combination of the cell's 8 corners, so the cell of that sample has an observed
+// corner v with d(v) ≤ 0, and the sample lies in [v − 1, v + 1] · s. Each resident block therefore
+// contributes the hull of those boxes over its observed voxels with d ≤ 0 (crossing_box), and a
+// block with none (free space in front of a surface, allocated by fusion's band) contributes
+// nothing. z is linear, so the depth of a ray point in a box lies between the depths of the box's
+// corners, and the pixel lies inside the bounding rectangle of their projections.
+//
+// Until 2026-12-06 each block contributed its whole box [8b, 8b + 8] · s, which holds every valid
+// sample, so rays began up to a block and a band before their surface (at 1280x720, 5 mm voxels,
+// 2.3 block skips and 1.6 samples of free space per ray). Now a ray starts at most a voxel before
+// the nearest box of its tile: the sample before the crossing is taken there instead of earlier,
+// which changes the hit of a few grazing rays either way (bench/RESULTS.md, 2026-12-06).
 #include "core/common/atomics.h"
 #include "core/common/camera.h"
 #include "core/common/fast_math.h"
@@ -20,7 +29,9 @@
 
 namespace rrg::kernel {
 
-inline constexpr int kRangeTile = 8;        // pixels per tile side
+// Pixels per tile side. 4: with boxes a few voxels deep, the tile's spread of depths (an oblique
+// surface across the tile) is what a ray still marches through before its own surface.
+inline constexpr int kRangeTile = 4;
 inline constexpr float kNoDepth = 1e30f;   // "no block" sentinel (near of an empty tile)
 
 // Depths are positive floats, whose bit patterns order like the floats, so the tiles keep int32
@@ -62,22 +73,20 @@ RRG_HD inline void range_at(const RangeImage& r, int x, int y, float& near, floa
   far = bits_float(r.far[t]);
 }
 
-// Projects block `key` (camera R_cw, t_cw) into the tiles it may cover. The march samples depths
-// z >= min_depth only, so the footprint is that of the box clipped by the plane z = min_depth: the
+// Projects the world box lo .. lo + size (camera R_cw, t_cw) into the tiles it may cover. The march
+// samples depths z >= min_depth only, so the footprint is that of the box clipped by the plane z = min_depth: the
 // bounding rectangle of the projections of the corners in front of the plane and of the points
 // where the box's edges cross it (the clipped box is convex, so its image is the hull of its
 // vertices' images). A block straddling the camera's plane therefore covers what it can reach, not
 // the whole image: next to a wall or floor beside the camera such blocks used to pull every tile's
 // near bound down to min_depth.
-RRG_TU_LOCAL RRG_HD inline void range_splat_block(const RangeImage& r, uint64_t key, float voxel_size, const Intrinsics& K,
-                                     const Eigen::Matrix3f& R_cw, const Eigen::Vector3f& t_cw, float min_depth,
-                                     float max_depth) {
-  const Eigen::Vector3f lo = (block_coord(key) * int(kBlockSide)).cast<float>() * voxel_size;
-  const float side = float(kBlockSide) * voxel_size;
+RRG_TU_LOCAL RRG_HD inline void range_splat_box(const RangeImage& r, const Eigen::Vector3f& lo, const Eigen::Vector3f& size,
+                                   const Intrinsics& K, const Eigen::Matrix3f& R_cw, const Eigen::Vector3f& t_cw,
+                                   float min_depth, float max_depth) {
   Eigen::Vector3f q[8];
   float z_lo = kNoDepth, z_hi = 0.0f;
   for (int c = 0; c < 8; ++c) {
-    q[c] = R_cw * (lo + side * Eigen::Vector3f(float(c & 1), float((c >> 1) & 1), float(c >> 2))) + t_cw;
+    q[c] = R_cw * (lo + size.cwiseProduct(Eigen::Vector3f(float(c & 1), float((c >> 1) & 1), float(c >> 2)))) + t_cw;
     z_lo = min_f(z_lo, q[c].z());
     z_hi = max_f(z_hi, q[c].z());
   }
@@ -120,6 +129,45 @@ RRG_TU_LOCAL RRG_HD inline void range_splat_block(const RangeImage& r, uint64_t 
       atomic_max(&r.near_neg[t], near_neg);
       atomic_max(&r.far[t], far);
     }
+}
+
+// The crossing box of block b (pool index; its voxels start at b · 512): the hull of [v − 1, v + 1]
+// over its observed voxels v with d(v) ≤ 0, as voxel offsets lo .. hi + 1 from the block's voxel 0
+// (lo in −1 .. 7, hi + 1 in 1 .. 9); false when it has no such voxel. One pass over the block's 512
+// TSDF values, a row of 8 as a bit mask.
+RRG_HD RRG_INLINE bool crossing_box(Span<const TsdfVoxel> geometry, int64_t b, int lo[3], int hi[3]) {
+  const TsdfVoxel* v = &geometry[b * kBlockVoxels];
+  int x_lo = kBlockSide, x_hi = -1, y_lo = kBlockSide, y_hi = -1, z_lo = kBlockSide, z_hi = -1;
+  for (int z = 0; z < kBlockSide; ++z)
+    for (int y = 0; y < kBlockSide; ++y) {
+      const TsdfVoxel* row = v + local_index(0, y, z);
+      uint32_t mask = 0;
+      RRG_UNROLL
+      for (int x = 0; x < kBlockSide; ++x) mask |= uint32_t(row[x].weight != 0 && row[x].tsdf <= 0) << x;
+      if (mask == 0) continue;
+      const int a = lowest_bit(mask), c = highest_bit(mask);
+      x_lo = a < x_lo ? a : x_lo;
+      x_hi = c > x_hi ? c : x_hi;
+      y_lo = y < y_lo ? y : y_lo;
+      y_hi = y > y_hi ? y : y_hi;
+      z_lo = z < z_lo ? z : z_lo;
+      z_hi = z;
+    }
+  lo[0] = x_lo - 1, lo[1] = y_lo - 1, lo[2] = z_lo - 1;
+  hi[0] = x_hi, hi[1] = y_hi, hi[2] = z_hi;
+  return x_hi >= 0;
+}
+
+// Projects block b's crossing box (nothing when it has none) into the tiles.
+RRG_TU_LOCAL RRG_HD inline void range_splat_block(const RangeImage& r, Span<const TsdfVoxel> geometry, int64_t b,
+                                     uint64_t key, float voxel_size, const Intrinsics& K, const Eigen::Matrix3f& R_cw,
+                                     const Eigen::Vector3f& t_cw, float min_depth, float max_depth) {
+  int lo[3], hi[3];
+  if (!crossing_box(geometry, b, lo, hi)) return;
+  const Eigen::Vector3i g = block_coord(key) * int(kBlockSide);
+  const Eigen::Vector3f corner(float(g.x() + lo[0]), float(g.y() + lo[1]), float(g.z() + lo[2]));
+  const Eigen::Vector3f size(float(hi[0] + 1 - lo[0]), float(hi[1] + 1 - lo[1]), float(hi[2] + 1 - lo[2]));
+  range_splat_box(r, corner * voxel_size, size * voxel_size, K, R_cw, t_cw, min_depth, max_depth);
 }
 
 }  // namespace rrg::kernel

@@ -27,21 +27,21 @@ struct RaycastArgs {
   bool want_color, want_reflection, want_normals;  // RaycastOutputs: their images are empty when false
 };
 
-// Pixels per work item of the march: a row of a range tile on the CPU (one thread walks it with one
-// block cache), one pixel per GPU thread.
+// Pixels per work item of the march: a range tile on the CPU (one thread walks it with one block
+// cache), one pixel per GPU thread.
 template <class Backend>
 struct RaycastRun {
   static constexpr int value = 1;
 };
 template <>
 struct RaycastRun<CpuBackend> {
-  static constexpr int value = kRangeTile;
+  static constexpr int value = kRangeTile * kRangeTile;
 };
 
 enum class PixelRay { Outside, Miss, March };  // past the image edge; no block in range; a ray to march
 
-// Three passes: clear the range image, splat every resident block into it, march every pixel
-// within its tile's [near, far] (tsdf_range_device.h), then shade it.
+// Three passes: clear the range image, splat every resident block's crossing box into it, march
+// every pixel within its tile's [near, far] (tsdf_range_device.h), then shade it.
 template <class Backend>
 void raycast(Backend backend, const RaycastArgs& a) {
   const RaycastArgs args = a;
@@ -51,8 +51,8 @@ void raycast(Backend backend, const RaycastArgs& a) {
   parallel_for(backend, int64_t(a.range.tiles_x) * a.range.tiles_y,
                [=] RRG_HD(int64_t t) { range_clear(args.range, t); });
   parallel_for(backend, a.block_keys.size, [=] RRG_HD(int64_t b) {
-    range_splat_block(args.range, args.block_keys[b], args.volume.voxel_size, args.K, R_cw, t_cw,
-                      args.min_depth, args.max_depth);
+    range_splat_block(args.range, args.volume.geometry, b, args.block_keys[b], args.volume.voxel_size, args.K, R_cw,
+                      t_cw, args.min_depth, args.max_depth);
   });
   // Pixels in range-tile order (kRangeTile² consecutive indices per tile): neighbouring rays meet
   // the same blocks, so they share cache lines on the CPU and memory transactions on the GPU. A work

@@ -170,7 +170,7 @@ TEST(TsdfRaycast, FastMarchAgreesFromFarAndFromInside) {
   }
 }
 
-// The range image of blocks that straddle the camera's plane (a wall or floor beside the camera):
+// The range image of boxes (here whole blocks) that straddle the camera's plane (a wall or floor beside the camera):
 // conservative, since every point of a block at a depth the march samples (>= min_depth) that
 // projects into the image lies in a covered tile whose [near, far] holds its depth; and tight, since
 // it covers the part of the image the clipped block can reach, not the whole image (it did: every
@@ -190,7 +190,8 @@ TEST(TsdfRaycast, RangeOfABlockAcrossTheCameraPlaneIsConservativeAndTight) {
     const kernel::RangeImage range{{near_neg.data(), int64_t(near_neg.size())}, {far.data(), int64_t(far.size())},
                                    tiles_x, tiles_y};
     for (int64_t t = 0; t < int64_t(near_neg.size()); ++t) kernel::range_clear(range, t);
-    kernel::range_splat_block(range, block_key(b.x(), b.y(), b.z()), voxel, kSmallK, R_cw, t_cw, min_depth, max_depth);
+    kernel::range_splat_box(range, b.cast<float>() * side, Eigen::Vector3f::Constant(side), kSmallK, R_cw, t_cw,
+                            min_depth, max_depth);
     int covered = 0;
     for (int y = 0; y < kSmallK.height; y += kernel::kRangeTile)
       for (int x = 0; x < kSmallK.width; x += kernel::kRangeTile) {
@@ -223,6 +224,114 @@ TEST(TsdfRaycast, RangeOfABlockAcrossTheCameraPlaneIsConservativeAndTight) {
       EXPECT_EQ(seen, 0);
       EXPECT_EQ(covered, 0);
     }
+  }
+}
+
+// crossing_box: the hull of [v − 1, v + 1] over the observed voxels with d ≤ 0, by hand; a voxel
+// with d ≤ 0 that was never observed (weight 0) does not count, nor does a block of free space.
+TEST(TsdfRaycast, CrossingBoxIsTheHullOfTheObservedVoxelsAtOrBehindTheSurface) {
+  std::vector<TsdfVoxel> geometry(2 * kBlockVoxels);
+  for (auto& v : geometry) v = {voxel_codec::encode_tsdf(0.7f), 3};  // observed free space
+  TsdfVoxel* b1 = geometry.data() + kBlockVoxels;
+  b1[local_index(2, 3, 4)] = {voxel_codec::encode_tsdf(-0.2f), 1};
+  b1[local_index(6, 1, 7)] = {voxel_codec::encode_tsdf(0.0f), 2};
+  b1[local_index(7, 7, 0)] = {voxel_codec::encode_tsdf(-0.9f), 0};  // never observed
+  geometry[local_index(0, 0, 0)] = {voxel_codec::encode_tsdf(-0.5f), 0};
+  const Span<const TsdfVoxel> view{geometry.data(), int64_t(geometry.size())};
+  int lo[3], hi[3];
+  EXPECT_FALSE(kernel::crossing_box(view, 0, lo, hi));
+  ASSERT_TRUE(kernel::crossing_box(view, 1, lo, hi));
+  EXPECT_EQ(Eigen::Vector3i(lo[0], lo[1], lo[2]), Eigen::Vector3i(1, 0, 3));
+  EXPECT_EQ(Eigen::Vector3i(hi[0], hi[1], hi[2]), Eigen::Vector3i(6, 3, 7));
+  b1[local_index(0, 0, 0)] = {voxel_codec::encode_tsdf(-0.1f), 1};  // a corner voxel: the box leaves the block
+  ASSERT_TRUE(kernel::crossing_box(view, 1, lo, hi));
+  EXPECT_EQ(Eigen::Vector3i(lo[0], lo[1], lo[2]), Eigen::Vector3i(-1, -1, -1));
+  EXPECT_EQ(Eigen::Vector3i(hi[0], hi[1], hi[2]), Eigen::Vector3i(6, 3, 7));
+}
+
+// The range image of the raycast (every resident block's crossing box) holds every sample a march
+// can end on: each valid trilinear sample with f ≤ 0 on a pixel's ray, taken every 0.1 voxel, lies
+// in a block's crossing box and within its tile's [near, far]. And from a view of the whole scene it is tighter than whole
+// blocks: every covered tile's near bound is more than a voxel farther, and a tenth fewer tiles
+// are covered.
+TEST(TsdfRaycast, RangeOfCrossingBoxesHoldsEverySampleAtOrBehindTheSurface) {
+  const test::Scene scene{{{test::Primitive::Sphere, {0, 0, 0}, {0.2f, 0, 0}},
+                           {test::Primitive::Box, {0.25f, 0.1f, 0.1f}, {0.1f, 0.12f, 0.08f}}}};
+  TsdfVolume volume(params_1cm(), Device::cpu());
+  test::fuse_scene(volume, scene, kSmallK, test::cameras_around({0.05f, 0, 0}, 0.9f));
+  const TsdfParams& p = volume.params();
+  const kernel::VolumeView view{volume.hash_view(), volume.geometry(), volume.attributes(), p.voxel_size};
+  const Span<const uint64_t> keys = volume.block_keys();
+  const int tiles_x = (kSmallK.width + kernel::kRangeTile - 1) / kernel::kRangeTile;
+  const int tiles_y = (kSmallK.height + kernel::kRangeTile - 1) / kernel::kRangeTile;
+  // A novel view of the whole scene 0.9 m away, and one 8 cm from the sphere, where boxes straddle
+  // the camera's plane (there whole blocks and crossing boxes both reach min_depth in every tile).
+  for (const auto& [T, tight] : {std::pair{test::look_at({0.4f, -0.3f, -0.7f}, {0, 0, 0}), true},
+                                 std::pair{test::look_at({-0.25f, 0.05f, -0.12f}, {0.2f, 0, 0}), false}}) {
+    const Eigen::Matrix3f R_cw = T.linear().transpose();
+    const Eigen::Vector3f t_cw = -(R_cw * T.translation());
+    std::vector<int32_t> near_neg(size_t(tiles_x * tiles_y)), far(near_neg.size());
+    std::vector<int32_t> block_near_neg(near_neg.size()), block_far(near_neg.size());
+    const kernel::RangeImage range{{near_neg.data(), int64_t(near_neg.size())}, {far.data(), int64_t(far.size())},
+                                   tiles_x, tiles_y};
+    const kernel::RangeImage blocks{{block_near_neg.data(), int64_t(near_neg.size())},
+                                    {block_far.data(), int64_t(near_neg.size())}, tiles_x, tiles_y};
+    for (int64_t t = 0; t < int64_t(near_neg.size()); ++t) kernel::range_clear(range, t), kernel::range_clear(blocks, t);
+    const float side = float(kBlockSide) * p.voxel_size;
+    for (int64_t b = 0; b < keys.size; ++b) {
+      kernel::range_splat_block(range, volume.geometry(), b, keys[b], p.voxel_size, kSmallK, R_cw, t_cw, p.min_depth,
+                                p.max_depth);
+      kernel::range_splat_box(blocks, (block_coord(keys[b]) * int(kBlockSide)).cast<float>() * p.voxel_size,
+                              Eigen::Vector3f::Constant(side), kSmallK, R_cw, t_cw, p.min_depth, p.max_depth);
+    }
+    // p lies in the crossing box of one of the blocks around it (boxes reach a voxel beyond their block)
+    const auto in_a_box = [&](const Eigen::Vector3f& pt) {
+      const Eigen::Vector3f q = pt / p.voxel_size;
+      const Eigen::Vector3i g(int(std::floor(q.x())), int(std::floor(q.y())), int(std::floor(q.z())));
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const Eigen::Vector3i b(block_of(g.x()) + dx, block_of(g.y()) + dy, block_of(g.z()) + dz);
+            const int32_t i = kernel::hash_find(volume.hash_view(), block_key(b.x(), b.y(), b.z()));
+            int lo[3], hi[3];
+            if (i < 0 || !kernel::crossing_box(volume.geometry(), i, lo, hi)) continue;
+            const Eigen::Vector3f r = q - (b * int(kBlockSide)).cast<float>();
+            if (r.x() >= float(lo[0]) && r.x() <= float(hi[0] + 1) && r.y() >= float(lo[1]) &&
+                r.y() <= float(hi[1] + 1) && r.z() >= float(lo[2]) && r.z() <= float(hi[2] + 1))
+              return true;
+          }
+      return false;
+    };
+    kernel::BlockCache cache;
+    int negative = 0;
+    for (int y = 0; y < kSmallK.height; ++y)
+      for (int x = 0; x < kSmallK.width; ++x) {
+        const Eigen::Vector3f d = T.linear() * kSmallK.unproject(float(x), float(y), 1.0f);
+        float near, far_z;
+        kernel::range_at(range, x, y, near, far_z);
+        for (float z = p.min_depth; z < p.max_depth; z += 0.1f * p.voxel_size / d.norm()) {
+          float f;
+          if (!kernel::sample_tsdf(view, T.translation() + z * d, cache, f) || f > 0.0f) continue;
+          ++negative;
+          ASSERT_TRUE(in_a_box(T.translation() + z * d)) << "pixel " << x << " " << y << " z " << z;
+          ASSERT_LE(near, z) << "pixel " << x << " " << y;
+          ASSERT_GE(far_z, z) << "pixel " << x << " " << y;
+        }
+      }
+    EXPECT_GT(negative, 10000);
+    int covered = 0, covered_by_blocks = 0, farther = 0;
+    for (int y = 0; y < kSmallK.height; y += kernel::kRangeTile)
+      for (int x = 0; x < kSmallK.width; x += kernel::kRangeTile) {
+        float n, f, bn, bf;
+        kernel::range_at(range, x, y, n, f);
+        kernel::range_at(blocks, x, y, bn, bf);
+        covered += n <= f;
+        covered_by_blocks += bn <= bf;
+        farther += n <= f && n > bn + p.voxel_size;
+      }
+    if (!tight) continue;
+    EXPECT_LT(covered, covered_by_blocks * 9 / 10);
+    EXPECT_EQ(farther, covered);
   }
 }
 
