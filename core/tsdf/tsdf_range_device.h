@@ -14,9 +14,10 @@
 //
 // Until 2026-12-06 each block contributed its whole box [8b, 8b + 8] · s, which holds every valid
 // sample, so rays began up to a block and a band before their surface (at 1280x720, 5 mm voxels,
-// 2.3 block skips and 1.6 samples of free space per ray). Now a ray starts at most a voxel before
-// the nearest box of its tile: the sample before the crossing is taken there instead of earlier,
-// which changes the hit of a few grazing rays either way (bench/RESULTS.md, 2026-12-06).
+// 2.3 block skips and 1.6 samples of free space per ray). Now a ray starts at the nearest depth of
+// the boxes over its tile, about a voxel before the nearest voxel at or behind a surface there: the
+// sample before the crossing is taken there instead of earlier, which changes the hit of a few
+// grazing rays either way (bench/RESULTS.md, 2026-12-06).
 #include "core/common/atomics.h"
 #include "core/common/camera.h"
 #include "core/common/fast_math.h"
@@ -32,7 +33,7 @@ namespace rrg::kernel {
 // Pixels per tile side. 4: with boxes a few voxels deep, the tile's spread of depths (an oblique
 // surface across the tile) is what a ray still marches through before its own surface.
 inline constexpr int kRangeTile = 4;
-inline constexpr float kNoDepth = 1e30f;   // "no block" sentinel (near of an empty tile)
+inline constexpr float kNoDepth = 1e30f;   // "no box" sentinel (near of an empty tile)
 
 // Depths are positive floats, whose bit patterns order like the floats, so the tiles keep int32
 // bits and update them with atomic_max: far as +bits, near as −bits.
@@ -74,14 +75,15 @@ RRG_HD inline void range_at(const RangeImage& r, int x, int y, float& near, floa
 }
 
 // Projects the world box lo .. lo + size (camera R_cw, t_cw) into the tiles it may cover. The march
-// samples depths z >= min_depth only, so the footprint is that of the box clipped by the plane z = min_depth: the
-// bounding rectangle of the projections of the corners in front of the plane and of the points
-// where the box's edges cross it (the clipped box is convex, so its image is the hull of its
-// vertices' images). A block straddling the camera's plane therefore covers what it can reach, not
-// the whole image: next to a wall or floor beside the camera such blocks used to pull every tile's
-// near bound down to min_depth.
-RRG_TU_LOCAL RRG_HD inline void range_splat_box(const RangeImage& r, const Eigen::Vector3f& lo, const Eigen::Vector3f& size,
-                                   const Intrinsics& K, const Eigen::Matrix3f& R_cw, const Eigen::Vector3f& t_cw,
+// samples depths z >= min_depth only, so the footprint is that of the box clipped by the plane
+// z = min_depth: the bounding rectangle of the projections of the corners in front of the plane and
+// of the points where the box's edges cross it (the clipped box is convex, so its image is the hull
+// of its vertices' images). A box straddling the camera's plane therefore covers what it can reach,
+// not the whole image: next to a wall or floor beside the camera such boxes used to pull every
+// tile's near bound down to min_depth.
+RRG_TU_LOCAL RRG_HD inline void range_splat_box(const RangeImage& r, const Eigen::Vector3f& lo,
+                                   const Eigen::Vector3f& size, const Intrinsics& K,
+                                   const Eigen::Matrix3f& R_cw, const Eigen::Vector3f& t_cw,
                                    float min_depth, float max_depth) {
   Eigen::Vector3f q[8];
   float z_lo = kNoDepth, z_hi = 0.0f;

@@ -38,7 +38,7 @@ struct RaycastRun<CpuBackend> {
   static constexpr int value = kRangeTile * kRangeTile;
 };
 
-enum class PixelRay { Outside, Miss, March };  // past the image edge; no block in range; a ray to march
+enum class PixelRay { Outside, Miss, March };  // past the image edge; no box in range; a ray to march
 
 // Three passes: clear the range image, splat every resident block's crossing box into it, march
 // every pixel within its tile's [near, far] (tsdf_range_device.h), then shade it.

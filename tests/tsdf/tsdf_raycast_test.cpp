@@ -251,9 +251,9 @@ TEST(TsdfRaycast, CrossingBoxIsTheHullOfTheObservedVoxelsAtOrBehindTheSurface) {
 
 // The range image of the raycast (every resident block's crossing box) holds every sample a march
 // can end on: each valid trilinear sample with f ≤ 0 on a pixel's ray, taken every 0.1 voxel, lies
-// in a block's crossing box and within its tile's [near, far]. And from a view of the whole scene it is tighter than whole
-// blocks: every covered tile's near bound is more than a voxel farther, and a tenth fewer tiles
-// are covered.
+// in a block's crossing box and within its tile's [near, far]. And from a view of the whole scene
+// it is tighter than whole blocks: every covered tile's near bound is more than a voxel farther,
+// and a tenth fewer tiles are covered.
 TEST(TsdfRaycast, RangeOfCrossingBoxesHoldsEverySampleAtOrBehindTheSurface) {
   const test::Scene scene{{{test::Primitive::Sphere, {0, 0, 0}, {0.2f, 0, 0}},
                            {test::Primitive::Box, {0.25f, 0.1f, 0.1f}, {0.1f, 0.12f, 0.08f}}}};
@@ -276,7 +276,10 @@ TEST(TsdfRaycast, RangeOfCrossingBoxesHoldsEverySampleAtOrBehindTheSurface) {
                                    tiles_x, tiles_y};
     const kernel::RangeImage blocks{{block_near_neg.data(), int64_t(near_neg.size())},
                                     {block_far.data(), int64_t(near_neg.size())}, tiles_x, tiles_y};
-    for (int64_t t = 0; t < int64_t(near_neg.size()); ++t) kernel::range_clear(range, t), kernel::range_clear(blocks, t);
+    for (int64_t t = 0; t < int64_t(near_neg.size()); ++t) {
+      kernel::range_clear(range, t);
+      kernel::range_clear(blocks, t);
+    }
     const float side = float(kBlockSide) * p.voxel_size;
     for (int64_t b = 0; b < keys.size; ++b) {
       kernel::range_splat_block(range, volume.geometry(), b, keys[b], p.voxel_size, kSmallK, R_cw, t_cw, p.min_depth,
