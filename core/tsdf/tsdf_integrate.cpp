@@ -60,6 +60,7 @@ int64_t integrate_any(TsdfVolume& volume, const DeviceImage<float>& depth, const
                                   refl ? refl->reflection_mask->view() : ImageView<const uint8_t>{},
                                   remap.span()};
   RRG_DISPATCH(dev, kernel::integrate_cpu(a), kernel::integrate_cuda(a));
+  volume.update_crossing_boxes(active);  // the raycast's range image reads them
   return active.size;
 }
 

@@ -4,13 +4,11 @@
 // and farthest depth of the boxes it overlaps. A ray then marches only within its tile's
 // [near, far], and a tile no box projects into is a miss without any volume lookup.
 //
-// The boxes: a march ends on a hit at a valid sample with f ≤ 0 after one with f > 0. The trilinear
-// value is a convex combination of the cell's 8 corners, so the cell of that sample has an observed
-// corner v with d(v) ≤ 0, and the sample lies in [v − 1, v + 1] · s. Each resident block therefore
-// contributes the hull of those boxes over its observed voxels with d ≤ 0 (crossing_box), and a
-// block with none (free space in front of a surface, allocated by fusion's band) contributes
-// nothing. z is linear, so the depth of a ray point in a box lies between the depths of the box's
-// corners, and the pixel lies inside the bounding rectangle of their projections.
+// The boxes: each resident block's crossing box (crossing_box_device.h), the hull of the cells
+// where a march can end on a hit; a block with none (free space in front of a surface, allocated by
+// fusion's band) contributes nothing. z is linear, so the depth of a ray point in a box lies between
+// the depths of the box's corners, and the pixel lies inside the bounding rectangle of their
+// projections.
 //
 // Until 2026-12-06 each block contributed its whole box [8b, 8b + 8] · s, which holds every valid
 // sample, so rays began up to a block and a band before their surface (at 1280x720, 5 mm voxels,
@@ -22,6 +20,7 @@
 #include "core/common/camera.h"
 #include "core/common/fast_math.h"
 #include "core/common/span.h"
+#include "core/tsdf/crossing_box_device.h"
 #include "core/tsdf/voxel.h"
 
 #include <Eigen/Core>
@@ -133,39 +132,13 @@ RRG_TU_LOCAL RRG_HD inline void range_splat_box(const RangeImage& r, const Eigen
     }
 }
 
-// The crossing box of block b (pool index; its voxels start at b · 512): the hull of [v − 1, v + 1]
-// over its observed voxels v with d(v) ≤ 0, as voxel offsets lo .. hi + 1 from the block's voxel 0
-// (lo in −1 .. 7, hi + 1 in 1 .. 9); false when it has no such voxel. One pass over the block's 512
-// TSDF values, a row of 8 as a bit mask.
-RRG_HD RRG_INLINE bool crossing_box(Span<const TsdfVoxel> geometry, int64_t b, int lo[3], int hi[3]) {
-  const TsdfVoxel* v = &geometry[b * kBlockVoxels];
-  int x_lo = kBlockSide, x_hi = -1, y_lo = kBlockSide, y_hi = -1, z_lo = kBlockSide, z_hi = -1;
-  for (int z = 0; z < kBlockSide; ++z)
-    for (int y = 0; y < kBlockSide; ++y) {
-      const TsdfVoxel* row = v + local_index(0, y, z);
-      uint32_t mask = 0;
-      RRG_UNROLL
-      for (int x = 0; x < kBlockSide; ++x) mask |= uint32_t(row[x].weight != 0 && row[x].tsdf <= 0) << x;
-      if (mask == 0) continue;
-      const int a = lowest_bit(mask), c = highest_bit(mask);
-      x_lo = a < x_lo ? a : x_lo;
-      x_hi = c > x_hi ? c : x_hi;
-      y_lo = y < y_lo ? y : y_lo;
-      y_hi = y > y_hi ? y : y_hi;
-      z_lo = z < z_lo ? z : z_lo;
-      z_hi = z;
-    }
-  lo[0] = x_lo - 1, lo[1] = y_lo - 1, lo[2] = z_lo - 1;
-  hi[0] = x_hi, hi[1] = y_hi, hi[2] = z_hi;
-  return x_hi >= 0;
-}
-
-// Projects block b's crossing box (nothing when it has none) into the tiles.
-RRG_TU_LOCAL RRG_HD inline void range_splat_block(const RangeImage& r, Span<const TsdfVoxel> geometry, int64_t b,
-                                     uint64_t key, float voxel_size, const Intrinsics& K, const Eigen::Matrix3f& R_cw,
-                                     const Eigen::Vector3f& t_cw, float min_depth, float max_depth) {
+// Projects a block's crossing box (its code in TsdfVolume::crossing_boxes; nothing when it has
+// none) into the tiles.
+RRG_TU_LOCAL RRG_HD inline void range_splat_block(const RangeImage& r, uint32_t box, uint64_t key, float voxel_size,
+                                     const Intrinsics& K, const Eigen::Matrix3f& R_cw, const Eigen::Vector3f& t_cw,
+                                     float min_depth, float max_depth) {
   int lo[3], hi[3];
-  if (!crossing_box(geometry, b, lo, hi)) return;
+  if (!decode_crossing_box(box, lo, hi)) return;
   const Eigen::Vector3i g = block_coord(key) * int(kBlockSide);
   const Eigen::Vector3f corner(float(g.x() + lo[0]), float(g.y() + lo[1]), float(g.z() + lo[2]));
   const Eigen::Vector3f size(float(hi[0] + 1 - lo[0]), float(hi[1] + 1 - lo[1]), float(hi[2] + 1 - lo[2]));

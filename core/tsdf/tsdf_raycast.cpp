@@ -29,7 +29,7 @@ void raycast_into(RaycastResult& r, const TsdfVolume& volume, const Intrinsics& 
   const int tiles_y = (h + kernel::kRangeTile - 1) / kernel::kRangeTile;
   Buffer<int32_t> near(size_t(tiles_x) * size_t(tiles_y), dev), far(size_t(tiles_x) * size_t(tiles_y), dev);
   kernel::RaycastArgs a{{volume.hash_view(), volume.geometry(), volume.attributes(), p.voxel_size},
-                        volume.block_keys(), K, T_wc.linear(), T_wc.translation(), p.truncation,
+                        volume.block_keys(), volume.crossing_boxes(), K, T_wc.linear(), T_wc.translation(), p.truncation,
                         p.min_depth, p.max_depth, {near.span(), far.span(), tiles_x, tiles_y},
                         remap.span(), r.depth.view(), r.vertices.view(), r.normals.view(), r.colors.view(),
                         r.plane_ids.view(), r.reflection.view(), r.reflection_mask.view(),

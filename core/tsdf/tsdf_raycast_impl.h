@@ -12,6 +12,7 @@ namespace rrg::kernel {
 struct RaycastArgs {
   VolumeView volume;
   Span<const uint64_t> block_keys;  // resident blocks (for the range image)
+  Span<const uint32_t> boxes;       // their crossing boxes (TsdfVolume::crossing_boxes)
   Intrinsics K;
   Eigen::Matrix3f R_wc;
   Eigen::Vector3f t_wc;
@@ -51,8 +52,8 @@ void raycast(Backend backend, const RaycastArgs& a) {
   parallel_for(backend, int64_t(a.range.tiles_x) * a.range.tiles_y,
                [=] RRG_HD(int64_t t) { range_clear(args.range, t); });
   parallel_for(backend, a.block_keys.size, [=] RRG_HD(int64_t b) {
-    range_splat_block(args.range, args.volume.geometry, b, args.block_keys[b], args.volume.voxel_size, args.K, R_cw,
-                      t_cw, args.min_depth, args.max_depth);
+    range_splat_block(args.range, args.boxes[b], args.block_keys[b], args.volume.voxel_size, args.K, R_cw, t_cw,
+                      args.min_depth, args.max_depth);
   });
   // Pixels in range-tile order (kRangeTile² consecutive indices per tile): neighbouring rays meet
   // the same blocks, so they share cache lines on the CPU and memory transactions on the GPU. A work

@@ -15,5 +15,8 @@ void gather_blocks_cpu(PoolView pool, Span<const int32_t> index, Span<Voxel> rec
 void scatter_blocks_cpu(Span<const Voxel> records, Span<const int32_t> index, PoolView pool) {
   scatter_blocks(CpuBackend{}, records, index, pool);
 }
+void update_crossing_boxes_cpu(Span<const TsdfVoxel> geometry, Span<const int32_t> blocks, Span<uint32_t> boxes) {
+  update_crossing_boxes(CpuBackend{}, geometry, blocks, boxes);
+}
 
 }  // namespace rrg::kernel

@@ -25,5 +25,8 @@ void gather_blocks_cuda(PoolView pool, Span<const int32_t> index, Span<Voxel> re
 void scatter_blocks_cuda(Span<const Voxel> records, Span<const int32_t> index, PoolView pool) {
   scatter_blocks(CudaBackend{}, records, index, pool);
 }
+void update_crossing_boxes_cuda(Span<const TsdfVoxel> geometry, Span<const int32_t> blocks, Span<uint32_t> boxes) {
+  update_crossing_boxes(CudaBackend{}, geometry, blocks, boxes);
+}
 
 }  // namespace rrg::kernel

@@ -3,6 +3,7 @@
 // blocks, rehash, block gather / scatter. Bodies templated on the back-end tag; instantiated by
 // tsdf_storage_cpu.cpp and tsdf_storage_cuda.cu.
 #include "core/common/camera.h"
+#include "core/tsdf/crossing_box_device.h"
 #include "core/tsdf/truncation_band.h"
 #include "core/tsdf/voxel_hash_device.h"
 
@@ -189,6 +190,16 @@ void scatter_blocks(Backend backend, Span<const Voxel> records, Span<const int32
   });
 }
 
+// boxes[b] ← the crossing box code of block b for each b in `blocks` (crossing_box_device.h).
+template <class Backend>
+void update_crossing_boxes(Backend backend, Span<const TsdfVoxel> geometry, Span<const int32_t> blocks,
+                           Span<uint32_t> boxes) {
+  parallel_for(backend, blocks.size, [=] RRG_HD(int64_t j) {
+    const int32_t b = blocks[j];
+    boxes[b] = encode_crossing_box(geometry, b);
+  });
+}
+
 void touch_blocks_cpu(const TouchArgs& a);
 void touch_blocks_cuda(const TouchArgs& a);
 void append_blocks_cpu(const AppendArgs& a);
@@ -201,5 +212,8 @@ void gather_blocks_cpu(PoolView pool, Span<const int32_t> index, Span<Voxel> rec
 void gather_blocks_cuda(PoolView pool, Span<const int32_t> index, Span<Voxel> records);
 void scatter_blocks_cpu(Span<const Voxel> records, Span<const int32_t> index, PoolView pool);
 void scatter_blocks_cuda(Span<const Voxel> records, Span<const int32_t> index, PoolView pool);
+
+void update_crossing_boxes_cpu(Span<const TsdfVoxel> geometry, Span<const int32_t> blocks, Span<uint32_t> boxes);
+void update_crossing_boxes_cuda(Span<const TsdfVoxel> geometry, Span<const int32_t> blocks, Span<uint32_t> boxes);
 
 }  // namespace rrg::kernel

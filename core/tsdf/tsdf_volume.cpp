@@ -57,6 +57,7 @@ TsdfVolume::TsdfVolume(const TsdfParams& params, const Device& device) : params_
   block_keys_ = Buffer<uint64_t>(size_t(blocks), device_);
   block_versions_ = Buffer<uint64_t>(size_t(blocks), device_);
   block_stamps_ = Buffer<int32_t>::zeros(size_t(blocks), device_);
+  crossing_boxes_ = Buffer<uint32_t>::zeros(size_t(blocks), device_);
   active_ = Buffer<int32_t>(size_t(blocks), device_);
   counters_ = Buffer<int32_t>::zeros(4, device_);
   rehash(next_pow2(std::max(kHashSlotsPerBlock * blocks, kMinHashSlots)));
@@ -72,7 +73,7 @@ MemoryUsage TsdfVolume::memory() const {
   MemoryUsage m;
   m.device_bytes = hash_keys_.size() * sizeof(uint64_t) + hash_values_.size() * sizeof(int32_t) +
                    geometry_.size() * sizeof(TsdfVoxel) + attributes_.size() * sizeof(AttrVoxel) +
-                   block_keys_.size() * (2 * sizeof(uint64_t) + sizeof(int32_t)) +
+                   block_keys_.size() * (2 * sizeof(uint64_t) + sizeof(int32_t) + sizeof(uint32_t)) +
                    new_keys_.size() * sizeof(uint64_t) + new_slots_.size() * sizeof(int32_t) +
                    active_.size() * sizeof(int32_t) + counters_.size() * sizeof(int32_t) +
                    (frame_scratch_.maps.vertices.buffer().size() + frame_scratch_.maps.normals.buffer().size()) *
@@ -139,6 +140,8 @@ void TsdfVolume::ensure_pool(int64_t blocks) {
   resize_keep(block_keys_, bigger, num_blocks_, device_);
   resize_keep(block_versions_, bigger, num_blocks_, device_);
   resize_keep(block_stamps_, bigger, num_blocks_, device_);
+  resize_keep(crossing_boxes_, bigger, num_blocks_, device_);
+  zero_range(crossing_boxes_, num_blocks_, bigger, device_);
   resize_keep(active_, bigger, int64_t(active_.size()), device_);
 }
 
@@ -297,6 +300,7 @@ int64_t TsdfVolume::stream_out(const Eigen::Vector3f& center, float radius) {
   }
   zero_range(geometry_, int64_t(keep.size()) * kBlockVoxels, num_blocks_ * kBlockVoxels, device_);
   zero_range(attributes_, int64_t(keep.size()) * kBlockVoxels, num_blocks_ * kBlockVoxels, device_);
+  zero_range(crossing_boxes_, int64_t(keep.size()), num_blocks_, device_);
   num_blocks_ = int64_t(keep.size());
   if (num_blocks_ > 0) {
     mem::copy(block_keys_.data(), device_, kept_keys.data(), Device::cpu(), kept_keys.size() * sizeof(uint64_t));
@@ -339,6 +343,17 @@ void TsdfVolume::scatter_records(const Buffer<Voxel>& records, const std::vector
   const Span<const Voxel> src = records.span();
   const Span<const int32_t> idx = index_d.span();
   RRG_DISPATCH(device_, kernel::scatter_blocks_cpu(src, idx, pool()), kernel::scatter_blocks_cuda(src, idx, pool()));
+  // The written blocks' crossing boxes (the slots may lie beyond num_blocks_ while the pool is compacted).
+  const Span<const TsdfVoxel> g = geometry_.span();
+  const Span<uint32_t> boxes = crossing_boxes_.span();
+  RRG_DISPATCH(device_, kernel::update_crossing_boxes_cpu(g, idx, boxes), kernel::update_crossing_boxes_cuda(g, idx, boxes));
+}
+
+void TsdfVolume::update_crossing_boxes(Span<const int32_t> blocks) {
+  const Span<const TsdfVoxel> g = geometry();
+  const Span<uint32_t> boxes{crossing_boxes_.data(), num_blocks_};
+  RRG_DISPATCH(device_, kernel::update_crossing_boxes_cpu(g, blocks, boxes),
+               kernel::update_crossing_boxes_cuda(g, blocks, boxes));
 }
 
 int64_t TsdfVolume::stream_in_all() {

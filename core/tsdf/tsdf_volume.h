@@ -83,6 +83,12 @@ class TsdfVolume {
   Span<const AttrVoxel> attributes() const { return {attributes_.data(), num_blocks_ * kBlockVoxels}; }
   Span<const uint64_t> block_keys() const { return {block_keys_.data(), num_blocks_}; }
   Span<uint64_t> block_versions() { return {block_versions_.data(), num_blocks_}; }
+  // Crossing box code of each resident block (crossing_box_device.h; the raycast's range image).
+  // Kept current by the volume where it writes voxels (streaming, insert_blocks) and by
+  // integrate(), which calls update_crossing_boxes on its active blocks after fusing them; code
+  // that writes voxels through geometry() itself must call it too.
+  Span<const uint32_t> crossing_boxes() const { return {crossing_boxes_.data(), num_blocks_}; }
+  void update_crossing_boxes(Span<const int32_t> blocks);
   // Allocates (and brings back from the host) every block on the rays of the valid depth pixels
   // within [d - ε, d + ε]; returns the indices of the blocks touched by this frame (the active set),
   // valid until the next call. Increments version().
@@ -119,6 +125,7 @@ class TsdfVolume {
   Buffer<uint64_t> block_keys_;      // [pool capacity]
   Buffer<uint64_t> block_versions_;  // [pool capacity] version of the last fusion into the block
   Buffer<int32_t> block_stamps_;     // [pool capacity] allocation pass that last listed it active
+  Buffer<uint32_t> crossing_boxes_;  // [pool capacity] crossing box codes; free slots kBoxUnknown (0)
   int64_t num_blocks_ = 0;
   uint64_t version_ = 0;
   int32_t pass_id_ = 0;

@@ -243,10 +243,76 @@ TEST(TsdfRaycast, CrossingBoxIsTheHullOfTheObservedVoxelsAtOrBehindTheSurface) {
   ASSERT_TRUE(kernel::crossing_box(view, 1, lo, hi));
   EXPECT_EQ(Eigen::Vector3i(lo[0], lo[1], lo[2]), Eigen::Vector3i(1, 0, 3));
   EXPECT_EQ(Eigen::Vector3i(hi[0], hi[1], hi[2]), Eigen::Vector3i(6, 3, 7));
+  // The volume's codes give the same boxes back; a code never computed is every voxel's box.
+  int dlo[3], dhi[3];
+  EXPECT_EQ(kernel::encode_crossing_box(view, 0), kernel::kNoCrossing);
+  EXPECT_FALSE(kernel::decode_crossing_box(kernel::kNoCrossing, dlo, dhi));
+  ASSERT_TRUE(kernel::decode_crossing_box(kernel::encode_crossing_box(view, 1), dlo, dhi));
+  EXPECT_EQ(Eigen::Vector3i(dlo[0], dlo[1], dlo[2]), Eigen::Vector3i(1, 0, 3));
+  EXPECT_EQ(Eigen::Vector3i(dhi[0], dhi[1], dhi[2]), Eigen::Vector3i(6, 3, 7));
   b1[local_index(0, 0, 0)] = {voxel_codec::encode_tsdf(-0.1f), 1};  // a corner voxel: the box leaves the block
   ASSERT_TRUE(kernel::crossing_box(view, 1, lo, hi));
   EXPECT_EQ(Eigen::Vector3i(lo[0], lo[1], lo[2]), Eigen::Vector3i(-1, -1, -1));
   EXPECT_EQ(Eigen::Vector3i(hi[0], hi[1], hi[2]), Eigen::Vector3i(6, 3, 7));
+  ASSERT_TRUE(kernel::decode_crossing_box(kernel::encode_crossing_box(view, 1), dlo, dhi));
+  EXPECT_EQ(Eigen::Vector3i(dlo[0], dlo[1], dlo[2]), Eigen::Vector3i(-1, -1, -1));
+  EXPECT_EQ(Eigen::Vector3i(dhi[0], dhi[1], dhi[2]), Eigen::Vector3i(6, 3, 7));
+  ASSERT_TRUE(kernel::decode_crossing_box(kernel::kBoxUnknown, dlo, dhi));
+  EXPECT_EQ(Eigen::Vector3i(dlo[0], dlo[1], dlo[2]), Eigen::Vector3i(-1, -1, -1));
+  EXPECT_EQ(Eigen::Vector3i(dhi[0], dhi[1], dhi[2]), Eigen::Vector3i(7, 7, 7));
+}
+
+// Every resident block's code in crossing_boxes() is its box from its voxels now: after fusion,
+// after streaming some blocks out (the pool compacts), after fusing frames that bring some back,
+// after streaming the rest in, and in a volume built from the blocks by insert_blocks (loading).
+void expect_boxes_current(const TsdfVolume& volume) {
+  const Span<const uint32_t> codes = volume.crossing_boxes();  // host memory (a CPU volume)
+  int with_box = 0, checked = 0;
+  const std::vector<Eigen::Vector3i> coords = volume.block_coords();
+  for (size_t b = 0; b < coords.size(); ++b) {
+    const std::optional<BlockData> data = volume.read_block(coords[b]);
+    ASSERT_TRUE(data);
+    std::vector<TsdfVoxel> g(kBlockVoxels);
+    for (int i = 0; i < kBlockVoxels; ++i) g[size_t(i)] = {data->voxels[size_t(i)].tsdf, data->voxels[size_t(i)].weight};
+    const uint32_t fresh = kernel::encode_crossing_box({g.data(), int64_t(g.size())}, 0);
+    ASSERT_EQ(codes[int64_t(b)], fresh) << "block " << b;
+    with_box += fresh != kernel::kNoCrossing;
+    ++checked;
+  }
+  EXPECT_GT(checked, 50);
+  EXPECT_GT(with_box, 10);
+  EXPECT_LT(with_box, checked);
+}
+
+TEST(TsdfRaycast, CrossingBoxesStayCurrentThroughFusionStreamingAndLoading) {
+  const test::Scene scene{{{test::Primitive::Sphere, {0, 0, 0}, {0.2f, 0, 0}},
+                           {test::Primitive::Box, {0.25f, 0.1f, 0.1f}, {0.1f, 0.12f, 0.08f}}}};
+  const std::vector<Eigen::Isometry3f> cameras = test::cameras_around({0.05f, 0, 0}, 0.9f);
+  TsdfVolume volume(params_1cm(), Device::cpu());
+  test::fuse_scene(volume, scene, kSmallK, {cameras.begin(), cameras.begin() + 6});
+  {
+    SCOPED_TRACE("fused");
+    expect_boxes_current(volume);
+  }
+  ASSERT_GT(volume.stream_out({0.2f, 0.0f, 0.0f}, 0.2f), 0);
+  {
+    SCOPED_TRACE("streamed out");
+    expect_boxes_current(volume);
+  }
+  test::fuse_scene(volume, scene, kSmallK, {cameras.begin() + 6, cameras.end()});
+  {
+    SCOPED_TRACE("fused again");
+    expect_boxes_current(volume);
+  }
+  volume.stream_in_all();
+  {
+    SCOPED_TRACE("streamed in");
+    expect_boxes_current(volume);
+  }
+  TsdfVolume loaded(params_1cm(), Device::cpu());
+  loaded.insert_blocks(volume.read_all_blocks());
+  SCOPED_TRACE("inserted");
+  expect_boxes_current(loaded);
 }
 
 // The range image of the raycast (every resident block's crossing box) holds every sample a march
@@ -282,8 +348,8 @@ TEST(TsdfRaycast, RangeOfCrossingBoxesHoldsEverySampleAtOrBehindTheSurface) {
     }
     const float side = float(kBlockSide) * p.voxel_size;
     for (int64_t b = 0; b < keys.size; ++b) {
-      kernel::range_splat_block(range, volume.geometry(), b, keys[b], p.voxel_size, kSmallK, R_cw, t_cw, p.min_depth,
-                                p.max_depth);
+      kernel::range_splat_block(range, volume.crossing_boxes()[b], keys[b], p.voxel_size, kSmallK, R_cw, t_cw,
+                                p.min_depth, p.max_depth);
       kernel::range_splat_box(blocks, (block_coord(keys[b]) * int(kBlockSide)).cast<float>() * p.voxel_size,
                               Eigen::Vector3f::Constant(side), kSmallK, R_cw, t_cw, p.min_depth, p.max_depth);
     }
