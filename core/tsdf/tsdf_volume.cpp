@@ -343,15 +343,13 @@ void TsdfVolume::scatter_records(const Buffer<Voxel>& records, const std::vector
   const Span<const Voxel> src = records.span();
   const Span<const int32_t> idx = index_d.span();
   RRG_DISPATCH(device_, kernel::scatter_blocks_cpu(src, idx, pool()), kernel::scatter_blocks_cuda(src, idx, pool()));
-  // The written blocks' crossing boxes (the slots may lie beyond num_blocks_ while the pool is compacted).
-  const Span<const TsdfVoxel> g = geometry_.span();
-  const Span<uint32_t> boxes = crossing_boxes_.span();
-  RRG_DISPATCH(device_, kernel::update_crossing_boxes_cpu(g, idx, boxes), kernel::update_crossing_boxes_cuda(g, idx, boxes));
+  update_crossing_boxes(idx);
 }
 
 void TsdfVolume::update_crossing_boxes(Span<const int32_t> blocks) {
-  const Span<const TsdfVoxel> g = geometry();
-  const Span<uint32_t> boxes{crossing_boxes_.data(), num_blocks_};
+  // Over the whole pool: while stream_out compacts it, written slots may lie beyond num_blocks_.
+  const Span<const TsdfVoxel> g = geometry_.span();
+  const Span<uint32_t> boxes = crossing_boxes_.span();
   RRG_DISPATCH(device_, kernel::update_crossing_boxes_cpu(g, blocks, boxes),
                kernel::update_crossing_boxes_cuda(g, blocks, boxes));
 }

@@ -1,6 +1,7 @@
 // The fast raycast (range image, block skipping, TSDF-sized steps, secant refinement) against a
 // brute-force reference that samples the same trilinear TSDF every 0.05 voxel from min_depth and
 // bisects the first +/− crossing: same hit/miss away from silhouettes, depth within 0.05 voxel.
+#include "core/common/memory.h"
 #include "core/tsdf/tsdf_range_device.h"
 #include "core/tsdf/tsdf_raycast.h"
 #include "core/tsdf/tsdf_raycast_device.h"
@@ -170,7 +171,8 @@ TEST(TsdfRaycast, FastMarchAgreesFromFarAndFromInside) {
   }
 }
 
-// The range image of boxes (here whole blocks) that straddle the camera's plane (a wall or floor beside the camera):
+// The range image of boxes (here whole blocks) that straddle the camera's plane (a wall or floor
+// beside the camera):
 // conservative, since every point of a block at a depth the march samples (>= min_depth) that
 // projects into the image lies in a covered tile whose [near, far] holds its depth; and tight, since
 // it covers the part of the image the clipped block can reach, not the whole image (it did: every
@@ -262,20 +264,23 @@ TEST(TsdfRaycast, CrossingBoxIsTheHullOfTheObservedVoxelsAtOrBehindTheSurface) {
   EXPECT_EQ(Eigen::Vector3i(dhi[0], dhi[1], dhi[2]), Eigen::Vector3i(7, 7, 7));
 }
 
-// Every resident block's code in crossing_boxes() is its box from its voxels now: after fusion,
-// after streaming some blocks out (the pool compacts), after fusing frames that bring some back,
-// after streaming the rest in, and in a volume built from the blocks by insert_blocks (loading).
+// Every resident block's code in crossing_boxes() is its box from its voxels now (worked out on
+// the host, so on CUDA this is also the kernel's parity check): after fusion, after streaming some
+// blocks out (the pool compacts), after fusing frames that bring some back, after streaming the
+// rest in, and in a volume built from the blocks by insert_blocks (loading).
 void expect_boxes_current(const TsdfVolume& volume) {
-  const Span<const uint32_t> codes = volume.crossing_boxes();  // host memory (a CPU volume)
+  const Span<const uint32_t> on_device = volume.crossing_boxes();
+  std::vector<uint32_t> codes(size_t(on_device.size));
+  mem::copy(codes.data(), Device::cpu(), on_device.data, volume.device(), codes.size() * sizeof(uint32_t));
   int with_box = 0, checked = 0;
   const std::vector<Eigen::Vector3i> coords = volume.block_coords();
   for (size_t b = 0; b < coords.size(); ++b) {
     const std::optional<BlockData> data = volume.read_block(coords[b]);
     ASSERT_TRUE(data);
     std::vector<TsdfVoxel> g(kBlockVoxels);
-    for (int i = 0; i < kBlockVoxels; ++i) g[size_t(i)] = {data->voxels[size_t(i)].tsdf, data->voxels[size_t(i)].weight};
+    for (int i = 0; i < kBlockVoxels; ++i) g[size_t(i)] = voxel_geometry(data->voxels[size_t(i)]);
     const uint32_t fresh = kernel::encode_crossing_box({g.data(), int64_t(g.size())}, 0);
-    ASSERT_EQ(codes[int64_t(b)], fresh) << "block " << b;
+    ASSERT_EQ(codes[b], fresh) << "block " << b;
     with_box += fresh != kernel::kNoCrossing;
     ++checked;
   }
@@ -284,11 +289,11 @@ void expect_boxes_current(const TsdfVolume& volume) {
   EXPECT_LT(with_box, checked);
 }
 
-TEST(TsdfRaycast, CrossingBoxesStayCurrentThroughFusionStreamingAndLoading) {
+void expect_boxes_current_through_streaming(const Device& device) {
   const test::Scene scene{{{test::Primitive::Sphere, {0, 0, 0}, {0.2f, 0, 0}},
                            {test::Primitive::Box, {0.25f, 0.1f, 0.1f}, {0.1f, 0.12f, 0.08f}}}};
   const std::vector<Eigen::Isometry3f> cameras = test::cameras_around({0.05f, 0, 0}, 0.9f);
-  TsdfVolume volume(params_1cm(), Device::cpu());
+  TsdfVolume volume(params_1cm(), device);
   test::fuse_scene(volume, scene, kSmallK, {cameras.begin(), cameras.begin() + 6});
   {
     SCOPED_TRACE("fused");
@@ -309,10 +314,17 @@ TEST(TsdfRaycast, CrossingBoxesStayCurrentThroughFusionStreamingAndLoading) {
     SCOPED_TRACE("streamed in");
     expect_boxes_current(volume);
   }
-  TsdfVolume loaded(params_1cm(), Device::cpu());
+  TsdfVolume loaded(params_1cm(), device);
   loaded.insert_blocks(volume.read_all_blocks());
   SCOPED_TRACE("inserted");
   expect_boxes_current(loaded);
+}
+
+TEST(TsdfRaycast, CrossingBoxesStayCurrentThroughFusionStreamingAndLoading) {
+  for (const Device& device : available_devices()) {
+    SCOPED_TRACE(device.to_string());
+    expect_boxes_current_through_streaming(device);
+  }
 }
 
 // The range image of the raycast (every resident block's crossing box) holds every sample a march
