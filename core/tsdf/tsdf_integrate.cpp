@@ -4,6 +4,7 @@
 #include "core/common/dispatch.h"
 #include "core/tsdf/tsdf_integrate_impl.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -80,6 +81,14 @@ DeviceImage<int32_t> plane_ids_to_device(const LabelImage& labels, const Device&
   Image<int32_t> ids(labels.width(), labels.height());
   for (size_t i = 0; i < labels.size(); ++i) ids[i] = labels[i];
   return DeviceImage<int32_t>::from_host(ids, device);
+}
+
+float view_reach(const Intrinsics& K, const TsdfParams& params) {
+  const float x = std::max(K.cx, float(K.width) - 1.0f - K.cx) / K.fx;
+  const float y = std::max(K.cy, float(K.height) - 1.0f - K.cy) / K.fy;
+  const float d = params.max_depth;
+  const float half_diagonal = 0.5f * std::sqrt(3.0f) * params.voxel_size * float(kBlockSide);
+  return d * std::sqrt(1.0f + x * x + y * y) + params.band().at(d) + half_diagonal;
 }
 
 }  // namespace rrg

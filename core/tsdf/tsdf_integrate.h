@@ -36,4 +36,10 @@ int64_t integrate(TsdfVolume& volume, const DeviceImage<float>& depth, const Dev
 // uint16 plane labels (LabelImage, as files store them) -> the int32 image integrate() takes.
 DeviceImage<int32_t> plane_ids_to_device(const LabelImage& labels, const Device& device);
 
+// The farthest from the camera centre that fusing one frame of camera K touches a block: the
+// rays through the image corners out to depth max_depth, the truncation band there, and half a
+// block's diagonal. A streaming radius (TsdfVolume::stream_out) below it sends blocks in view out
+// after each frame and brings them back with the next.
+float view_reach(const Intrinsics& K, const TsdfParams& params);
+
 }  // namespace rrg

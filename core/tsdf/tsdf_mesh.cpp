@@ -6,6 +6,8 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 #include <tuple>
 #include <unordered_map>
 
@@ -71,14 +73,15 @@ void append_from(std::vector<T>& out, const Buffer<T>& b, const Device& dev) {
   if (!b.empty()) mem::copy(out.data() + at, Device::cpu(), b.data(), dev, b.size() * sizeof(T));
 }
 
-TriangleMesh mesh_pool_blocks(const TsdfVolume& volume, const std::vector<int32_t>& blocks,
-                              std::span<const int32_t> plane_remap) {
+// Appends the unwelded triangles of the resident pool slots `blocks` (in that order) to mesh, and
+// each new vertex's edge key to keys.
+void emit_pool_blocks(const TsdfVolume& volume, const std::vector<int32_t>& blocks, std::span<const int32_t> plane_remap,
+                      TriangleMesh& mesh, std::vector<Eigen::Vector4i>& keys) {
+  if (blocks.empty()) return;
   const Device& dev = volume.device();
   const auto& table_host = mc::triangle_table();
   const auto table = Buffer<int8_t>::from_host(table_host, dev);
   const auto remap = Buffer<int32_t>::from_host(plane_remap, dev);
-  TriangleMesh mesh;
-  std::vector<Eigen::Vector4i> keys;
   const size_t batch = std::min(blocks.size(), size_t(batch_blocks(dev)));
   Buffer<int32_t> scratch(batch * kernel::kEdgeSlots, dev), counts(2 * batch, dev);
   for (size_t start = 0; start < blocks.size(); start += batch) {
@@ -118,6 +121,13 @@ TriangleMesh mesh_pool_blocks(const TsdfVolume& volume, const std::vector<int32_
     append_from(keys, edge_keys, dev);
     append_from(mesh.triangles, tris, dev);
   }
+}
+
+TriangleMesh mesh_pool_blocks(const TsdfVolume& volume, const std::vector<int32_t>& blocks,
+                              std::span<const int32_t> plane_remap) {
+  TriangleMesh mesh;
+  std::vector<Eigen::Vector4i> keys;
+  emit_pool_blocks(volume, blocks, plane_remap, mesh, keys);
   weld(mesh, keys);
   return mesh;
 }
@@ -138,7 +148,7 @@ void sort_by_coords(std::vector<int32_t>& blocks, const std::vector<Eigen::Vecto
 TriangleMesh extract_mesh(const TsdfVolume& volume, std::span<const int32_t> plane_remap) {
   if (volume.num_host_blocks() > 0)
     spdlog::warn("extract_mesh: {} blocks are streamed out to host memory and not meshed "
-                 "(stream_in_all() first to mesh everything)", volume.num_host_blocks());
+                 "(extract_mesh_streamed() meshes everything)", volume.num_host_blocks());
   std::vector<int32_t> blocks(size_t(volume.num_blocks()));
   for (size_t i = 0; i < blocks.size(); ++i) blocks[i] = int32_t(i);
   sort_by_coords(blocks, volume.block_coords());
@@ -157,6 +167,58 @@ TriangleMesh extract_mesh(const TsdfVolume& volume, std::span<const Eigen::Vecto
   blocks.erase(std::unique(blocks.begin(), blocks.end()), blocks.end());
   sort_by_coords(blocks, all);
   return mesh_pool_blocks(volume, blocks, plane_remap);
+}
+
+TriangleMesh extract_mesh_streamed(TsdfVolume& volume, int64_t max_resident_blocks,
+                                   std::span<const int32_t> plane_remap) {
+  if (volume.num_host_blocks() == 0) return extract_mesh(volume, plane_remap);
+  if (max_resident_blocks < 1)
+    throw std::invalid_argument("extract_mesh_streamed: max_resident_blocks must be >= 1, got " +
+                                std::to_string(max_resident_blocks));
+  const auto key_of = [](const Eigen::Vector3i& c) { return block_key(c.x(), c.y(), c.z()); };
+  const std::vector<Eigen::Vector3i> resident = volume.block_coords();
+  std::vector<Eigen::Vector3i> all = volume.host_block_coords();
+  all.insert(all.end(), resident.begin(), resident.end());
+  std::sort(all.begin(), all.end(), [&](const auto& a, const auto& b) { return key_of(a) < key_of(b); });
+  // Block keys order by x first, so a slab of consecutive x is a run of `all`, and meshing the slabs
+  // in turn emits the blocks in the order of extract_mesh: one weld at the end gives its bytes.
+  const auto layer_end = [&](size_t i) {
+    size_t e = i;
+    while (e < all.size() && all[e].x() == all[i].x()) ++e;
+    return e;
+  };
+  // Marching cubes reads the +x neighbour layer too (the cubes on a block's +x face).
+  const auto margin = [&](size_t end) {
+    return end < all.size() && all[end].x() == all[end - 1].x() + 1 ? layer_end(end) - end : size_t{0};
+  };
+  volume.stream_out(resident);
+  TriangleMesh mesh;
+  std::vector<Eigen::Vector4i> keys;
+  const size_t budget = size_t(max_resident_blocks);
+  size_t slabs = 0, peak = 0;
+  for (size_t begin = 0; begin < all.size();) {
+    size_t end = layer_end(begin);
+    while (end < all.size() && layer_end(end) - begin + margin(layer_end(end)) <= budget) end = layer_end(end);
+    const size_t with_margin = end + margin(end);
+    volume.stream_out(volume.block_coords());
+    volume.stream_in(std::span(all).subspan(begin, with_margin - begin));
+    peak = std::max(peak, size_t(volume.num_blocks()));
+    const std::vector<Eigen::Vector3i> pool = volume.block_coords();
+    std::unordered_map<uint64_t, int32_t> slot;
+    for (size_t i = 0; i < pool.size(); ++i) slot[key_of(pool[i])] = int32_t(i);
+    std::vector<int32_t> blocks;
+    blocks.reserve(end - begin);
+    for (size_t i = begin; i < end; ++i) blocks.push_back(slot.at(key_of(all[i])));
+    emit_pool_blocks(volume, blocks, plane_remap, mesh, keys);
+    ++slabs;
+    begin = end;
+  }
+  volume.stream_out(volume.block_coords());
+  volume.stream_in(resident);
+  spdlog::debug("extract_mesh_streamed: {} blocks in {} slabs, at most {} resident (budget {})", all.size(), slabs,
+                peak, budget);
+  weld(mesh, keys);
+  return mesh;
 }
 
 }  // namespace rrg

@@ -18,4 +18,12 @@ TriangleMesh extract_mesh(const TsdfVolume& volume, std::span<const int32_t> pla
 TriangleMesh extract_mesh(const TsdfVolume& volume, std::span<const Eigen::Vector3i> blocks,
                           std::span<const int32_t> plane_remap = {});
 
+// Every block, resident or streamed out to host memory: the same mesh, byte for byte, as
+// stream_in_all() then extract_mesh(), made in slabs of consecutive block x with no more than
+// max_resident_blocks blocks resident at a time (more only where one slab of x and its +x
+// neighbour layer hold more). Leaves resident the blocks that were resident before. For maps
+// larger than the device (streaming, tsdf.md); without streamed-out blocks it is extract_mesh().
+TriangleMesh extract_mesh_streamed(TsdfVolume& volume, int64_t max_resident_blocks,
+                                   std::span<const int32_t> plane_remap = {});
+
 }  // namespace rrg

@@ -105,7 +105,9 @@ std::optional<BlockData> TsdfVolume::read_block(const Eigen::Vector3i& coord) co
   const auto it = std::find(keys.begin(), keys.end(), key);
   if (it == keys.end()) return std::nullopt;
   const size_t i = size_t(it - keys.begin());
-  BlockData b{coord, 0, gather_records({int32_t(i)}).to_host()};
+  BlockData b{coord, 0, {}};
+  const int32_t slot = int32_t(i);
+  download_blocks(std::span(&slot, 1), [&](size_t, std::span<const Voxel> v) { b.voxels.assign(v.begin(), v.end()); });
   mem::copy(&b.version, Device::cpu(), block_versions_.data() + i, device_, sizeof(uint64_t));
   return b;
 }
@@ -115,12 +117,11 @@ std::vector<BlockData> TsdfVolume::read_all_blocks() const {
   const auto versions = download_prefix(block_versions_, num_blocks_);
   std::vector<int32_t> all(static_cast<size_t>(num_blocks_));
   std::iota(all.begin(), all.end(), 0);
-  const auto voxels = gather_records(all).to_host();
   std::vector<BlockData> out;
   out.reserve(keys.size() + host_blocks_.size());
-  for (size_t i = 0; i < keys.size(); ++i)
-    out.push_back({block_coord(keys[i]), versions[i],
-                   std::vector<Voxel>(voxels.begin() + i * kBlockVoxels, voxels.begin() + (i + 1) * kBlockVoxels)});
+  download_blocks(all, [&](size_t i, std::span<const Voxel> v) {
+    out.push_back({block_coord(keys[i]), versions[i], std::vector<Voxel>(v.begin(), v.end())});
+  });
   for (const auto& [key, block] : host_blocks_) out.push_back(block);
   std::sort(out.begin(), out.end(), [](const BlockData& a, const BlockData& b) {
     return block_key(a.coord.x(), a.coord.y(), a.coord.z()) < block_key(b.coord.x(), b.coord.y(), b.coord.z());
@@ -230,14 +231,14 @@ void TsdfVolume::append_blocks(std::span<const uint64_t> keys, std::span<const i
   num_blocks_ += n;
   // Blocks coming back from host memory: their voxels replace the zeros of the free slots.
   std::vector<int32_t> index;
-  std::vector<Voxel> staged;
+  std::vector<const BlockData*> back;
   for (int64_t j = 0; j < n; ++j) {
     if (!restored[size_t(j)]) continue;
     index.push_back(int32_t(first + j));
-    staged.insert(staged.end(), restored[size_t(j)]->voxels.begin(), restored[size_t(j)]->voxels.end());
+    back.push_back(restored[size_t(j)]);
   }
   if (!index.empty()) {
-    scatter_records(Buffer<Voxel>::from_host(staged, device_), index);
+    upload_blocks(index, [&](size_t j) { return std::span<const Voxel>(back[j]->voxels); });
     for (int64_t j = 0; j < n; ++j)
       if (restored[size_t(j)]) host_blocks_.erase(keys[size_t(j)]);
     spdlog::debug("tsdf: {} blocks streamed back in", index.size());
@@ -245,23 +246,27 @@ void TsdfVolume::append_blocks(std::span<const uint64_t> keys, std::span<const i
 }
 
 void TsdfVolume::insert_blocks(std::span<const BlockData> blocks) {
+  std::vector<const BlockData*> ptrs;
+  ptrs.reserve(blocks.size());
+  for (const BlockData& b : blocks) ptrs.push_back(&b);
+  insert_block_ptrs(ptrs);
+}
+
+void TsdfVolume::insert_block_ptrs(std::span<const BlockData* const> blocks) {
   if (blocks.empty()) return;
   const auto existing = download_prefix(block_keys_, num_blocks_);
   std::vector<uint64_t> present(existing);
   std::sort(present.begin(), present.end());
   const int64_t n = int64_t(blocks.size()), first = num_blocks_;
   std::vector<uint64_t> keys, versions;
-  std::vector<Voxel> staged;
-  staged.reserve(size_t(n) * kBlockVoxels);
-  for (const BlockData& b : blocks) {
-    if (!block_in_range(b.coord.x(), b.coord.y(), b.coord.z()) || b.voxels.size() != size_t(kBlockVoxels))
+  for (const BlockData* b : blocks) {
+    if (!block_in_range(b->coord.x(), b->coord.y(), b->coord.z()) || b->voxels.size() != size_t(kBlockVoxels))
       throw std::invalid_argument("TsdfVolume::insert_blocks: block out of range or not 512 voxels");
-    const uint64_t key = block_key(b.coord.x(), b.coord.y(), b.coord.z());
+    const uint64_t key = block_key(b->coord.x(), b->coord.y(), b->coord.z());
     if (std::binary_search(present.begin(), present.end(), key))
       throw std::invalid_argument("TsdfVolume::insert_blocks: block already present");
     keys.push_back(key);
-    versions.push_back(b.version);
-    staged.insert(staged.end(), b.voxels.begin(), b.voxels.end());
+    versions.push_back(b->version);
   }
   ensure_pool(first + n);
   mem::copy(block_keys_.data() + first, device_, keys.data(), Device::cpu(), keys.size() * sizeof(uint64_t));
@@ -270,38 +275,57 @@ void TsdfVolume::insert_blocks(std::span<const BlockData> blocks) {
   num_blocks_ += n;
   std::vector<int32_t> index(static_cast<size_t>(n));
   std::iota(index.begin(), index.end(), int32_t(first));
-  scatter_records(Buffer<Voxel>::from_host(staged, device_), index);
+  upload_blocks(index, [&](size_t j) { return std::span<const Voxel>(blocks[j]->voxels); });
   rehash(std::max(hash_capacity(), next_pow2(4 * num_blocks_)));
 }
 
 int64_t TsdfVolume::stream_out(const Eigen::Vector3f& center, float radius) {
+  return stream_out_where([&](uint64_t key) {
+    return (block_center(block_coord(key), params_.voxel_size) - center).norm() > radius;
+  });
+}
+
+int64_t TsdfVolume::stream_out(std::span<const Eigen::Vector3i> blocks) {
+  std::vector<uint64_t> listed;
+  listed.reserve(blocks.size());
+  for (const auto& c : blocks)
+    if (block_in_range(c.x(), c.y(), c.z())) listed.push_back(block_key(c.x(), c.y(), c.z()));
+  std::sort(listed.begin(), listed.end());
+  return stream_out_where([&](uint64_t key) { return std::binary_search(listed.begin(), listed.end(), key); });
+}
+
+template <class Leave>
+int64_t TsdfVolume::stream_out_where(Leave leave) {
   const auto keys = download_prefix(block_keys_, num_blocks_);
   const auto versions = download_prefix(block_versions_, num_blocks_);
-  std::vector<int32_t> out, keep;
+  std::vector<int32_t> out;  // ascending
   for (int64_t i = 0; i < num_blocks_; ++i)
-    ((block_center(block_coord(keys[size_t(i)]), params_.voxel_size) - center).norm() > radius ? out : keep)
-        .push_back(int32_t(i));
+    if (leave(keys[size_t(i)])) out.push_back(int32_t(i));
   if (out.empty()) return 0;
-  const std::vector<Voxel> host = gather_records(out).to_host();
-  for (size_t j = 0; j < out.size(); ++j) {
+  download_blocks(out, [&](size_t j, std::span<const Voxel> v) {
     const uint64_t key = keys[size_t(out[j])];
-    host_blocks_[key] = BlockData{block_coord(key), versions[size_t(out[j])],
-                                  std::vector<Voxel>(host.begin() + j * kBlockVoxels, host.begin() + (j + 1) * kBlockVoxels)};
+    host_blocks_[key] = BlockData{block_coord(key), versions[size_t(out[j])], std::vector<Voxel>(v.begin(), v.end())};
+  });
+  // Compact the pool: the kept blocks in its tail fill the slots the leaving blocks free in front,
+  // so the work is in proportion to the blocks moved, not to the pool. Then rebuild the hash.
+  const int64_t kept = num_blocks_ - int64_t(out.size());
+  std::vector<int32_t> holes, movers;
+  for (int32_t i : out)
+    if (i < kept) holes.push_back(i);
+  for (int64_t i = kept, j = 0; i < num_blocks_; ++i) {
+    while (j < int64_t(out.size()) && out[size_t(j)] < i) ++j;
+    if (j == int64_t(out.size()) || out[size_t(j)] != i) movers.push_back(int32_t(i));
   }
-  // Compact the pool to the kept blocks (in their order) and rebuild the hash.
-  const Buffer<Voxel> kept = gather_records(keep);
-  std::vector<int32_t> front(keep.size());
-  std::iota(front.begin(), front.end(), 0);
-  scatter_records(kept, front);
-  std::vector<uint64_t> kept_keys, kept_versions;
-  for (int32_t i : keep) {
-    kept_keys.push_back(keys[size_t(i)]);
-    kept_versions.push_back(versions[size_t(i)]);
+  std::vector<uint64_t> kept_keys(keys.begin(), keys.begin() + kept), kept_versions(versions.begin(), versions.begin() + kept);
+  for (size_t j = 0; j < holes.size(); ++j) {
+    kept_keys[size_t(holes[j])] = keys[size_t(movers[j])];
+    kept_versions[size_t(holes[j])] = versions[size_t(movers[j])];
   }
-  zero_range(geometry_, int64_t(keep.size()) * kBlockVoxels, num_blocks_ * kBlockVoxels, device_);
-  zero_range(attributes_, int64_t(keep.size()) * kBlockVoxels, num_blocks_ * kBlockVoxels, device_);
-  zero_range(crossing_boxes_, int64_t(keep.size()), num_blocks_, device_);
-  num_blocks_ = int64_t(keep.size());
+  move_blocks(movers, holes);
+  zero_range(geometry_, kept * kBlockVoxels, num_blocks_ * kBlockVoxels, device_);
+  zero_range(attributes_, kept * kBlockVoxels, num_blocks_ * kBlockVoxels, device_);
+  zero_range(crossing_boxes_, kept, num_blocks_, device_);
+  num_blocks_ = kept;
   if (num_blocks_ > 0) {
     mem::copy(block_keys_.data(), device_, kept_keys.data(), Device::cpu(), kept_keys.size() * sizeof(uint64_t));
     mem::copy(block_versions_.data(), device_, kept_versions.data(), Device::cpu(), kept_versions.size() * sizeof(uint64_t));
@@ -313,31 +337,97 @@ int64_t TsdfVolume::stream_out(const Eigen::Vector3f& center, float radius) {
 }
 
 int64_t TsdfVolume::stream_in(const Eigen::Vector3f& center, float radius) {
-  std::vector<BlockData> back;
+  std::vector<const BlockData*> back;
   for (const auto& [key, block] : host_blocks_)
-    if ((block_center(block.coord, params_.voxel_size) - center).norm() <= radius) back.push_back(block);
-  std::sort(back.begin(), back.end(), [](const BlockData& a, const BlockData& b) {
-    return block_key(a.coord.x(), a.coord.y(), a.coord.z()) < block_key(b.coord.x(), b.coord.y(), b.coord.z());
-  });
-  insert_blocks(back);
-  for (const BlockData& b : back) host_blocks_.erase(block_key(b.coord.x(), b.coord.y(), b.coord.z()));
-  return int64_t(back.size());
+    if ((block_center(block.coord, params_.voxel_size) - center).norm() <= radius) back.push_back(&block);
+  return stream_in_blocks(std::move(back));
+}
+
+int64_t TsdfVolume::stream_in(std::span<const Eigen::Vector3i> blocks) {
+  std::vector<const BlockData*> back;
+  for (const auto& c : blocks) {
+    if (!block_in_range(c.x(), c.y(), c.z())) continue;
+    if (auto it = host_blocks_.find(block_key(c.x(), c.y(), c.z())); it != host_blocks_.end()) back.push_back(&it->second);
+  }
+  return stream_in_blocks(std::move(back));
+}
+
+int64_t TsdfVolume::stream_in_blocks(std::vector<const BlockData*> back) {
+  // The host copies are dropped only once the blocks are in the pool: nothing is lost if that throws.
+  const auto key_of = [](const BlockData* b) { return block_key(b->coord.x(), b->coord.y(), b->coord.z()); };
+  std::sort(back.begin(), back.end(), [&](const BlockData* a, const BlockData* b) { return key_of(a) < key_of(b); });
+  back.erase(std::unique(back.begin(), back.end()), back.end());
+  insert_block_ptrs(back);
+  std::vector<uint64_t> keys;
+  keys.reserve(back.size());
+  for (const BlockData* b : back) keys.push_back(key_of(b));
+  for (uint64_t k : keys) host_blocks_.erase(k);
+  return int64_t(keys.size());
+}
+
+std::vector<Eigen::Vector3i> TsdfVolume::host_block_coords() const {
+  std::vector<uint64_t> keys;
+  keys.reserve(host_blocks_.size());
+  for (const auto& [key, block] : host_blocks_) keys.push_back(key);
+  std::sort(keys.begin(), keys.end());
+  std::vector<Eigen::Vector3i> out;
+  out.reserve(keys.size());
+  for (uint64_t k : keys) out.push_back(block_coord(k));
+  return out;
 }
 
 kernel::PoolView TsdfVolume::pool() { return {geometry_.span(), attributes_.span()}; }
 
-Buffer<Voxel> TsdfVolume::gather_records(const std::vector<int32_t>& index) const {
-  if (index.empty()) return Buffer<Voxel>(0, device_);
+template <class Sink>
+void TsdfVolume::download_blocks(std::span<const int32_t> slots, Sink&& sink) const {
+  if (slots.empty()) return;
+  Buffer<Voxel> stage(std::min(slots.size(), kTransferBlocks) * kBlockVoxels, device_);
+  std::vector<Voxel> host(stage.size());
+  for (size_t start = 0; start < slots.size(); start += kTransferBlocks) {
+    const auto chunk = slots.subspan(start, std::min(kTransferBlocks, slots.size() - start));
+    gather_records(chunk, stage);
+    mem::copy(host.data(), Device::cpu(), stage.data(), device_, chunk.size() * kBlockVoxels * sizeof(Voxel));
+    for (size_t j = 0; j < chunk.size(); ++j)
+      sink(start + j, std::span<const Voxel>(host).subspan(j * kBlockVoxels, kBlockVoxels));
+  }
+}
+
+template <class Source>
+void TsdfVolume::upload_blocks(std::span<const int32_t> slots, Source&& source) {
+  if (slots.empty()) return;
+  Buffer<Voxel> stage(std::min(slots.size(), kTransferBlocks) * kBlockVoxels, device_);
+  std::vector<Voxel> host(stage.size());
+  for (size_t start = 0; start < slots.size(); start += kTransferBlocks) {
+    const auto chunk = slots.subspan(start, std::min(kTransferBlocks, slots.size() - start));
+    for (size_t j = 0; j < chunk.size(); ++j) {
+      const std::span<const Voxel> v = source(start + j);
+      std::copy(v.begin(), v.end(), host.begin() + std::ptrdiff_t(j * kBlockVoxels));
+    }
+    mem::copy(stage.data(), device_, host.data(), Device::cpu(), chunk.size() * kBlockVoxels * sizeof(Voxel));
+    scatter_records(stage, chunk);
+  }
+}
+
+void TsdfVolume::move_blocks(std::span<const int32_t> from, std::span<const int32_t> to) {
+  if (from.empty()) return;
+  Buffer<Voxel> stage(std::min(from.size(), kTransferBlocks) * kBlockVoxels, device_);
+  for (size_t start = 0; start < from.size(); start += kTransferBlocks) {
+    const size_t m = std::min(kTransferBlocks, from.size() - start);
+    gather_records(from.subspan(start, m), stage);
+    scatter_records(stage, to.subspan(start, m));
+  }
+}
+
+void TsdfVolume::gather_records(std::span<const int32_t> index, Buffer<Voxel>& records) const {
+  if (index.empty()) return;
   const auto index_d = Buffer<int32_t>::from_host(index, device_);
-  Buffer<Voxel> records(index.size() * kBlockVoxels, device_);
   const kernel::PoolView p = const_cast<TsdfVolume&>(*this).pool();  // read only
   const Span<const int32_t> idx = index_d.span();
   RRG_DISPATCH(device_, kernel::gather_blocks_cpu(p, idx, records.span()),
                kernel::gather_blocks_cuda(p, idx, records.span()));
-  return records;
 }
 
-void TsdfVolume::scatter_records(const Buffer<Voxel>& records, const std::vector<int32_t>& index) {
+void TsdfVolume::scatter_records(const Buffer<Voxel>& records, std::span<const int32_t> index) {
   if (index.empty()) return;
   const auto index_d = Buffer<int32_t>::from_host(index, device_);
   const Span<const Voxel> src = records.span();

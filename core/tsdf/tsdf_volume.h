@@ -72,6 +72,12 @@ class TsdfVolume {
   int64_t stream_out(const Eigen::Vector3f& center, float radius);
   int64_t stream_in(const Eigen::Vector3f& center, float radius);
   int64_t stream_in_all();
+  // The same for listed blocks: coordinates not resident (for stream_out) or not streamed out
+  // (for stream_in) are ignored.
+  int64_t stream_out(std::span<const Eigen::Vector3i> blocks);
+  int64_t stream_in(std::span<const Eigen::Vector3i> blocks);
+  // Coordinates of the streamed-out blocks, sorted (x, then y, then z).
+  std::vector<Eigen::Vector3i> host_block_coords() const;
 
   // --- used by the algorithms (tsdf_integrate.cpp, tsdf_raycast.cpp, ...) -----------------------
   kernel::HashView hash_view() { return {hash_keys_.span(), hash_values_.span()}; }
@@ -112,9 +118,24 @@ class TsdfVolume {
   void append_blocks(std::span<const uint64_t> keys, std::span<const int64_t> slots,
                      std::span<const BlockData* const> restored, int64_t active_offset);
   kernel::PoolView pool();
-  // Voxel records (on the volume's device) of the resident blocks `index`, and the way back.
-  Buffer<Voxel> gather_records(const std::vector<int32_t>& index) const;
-  void scatter_records(const Buffer<Voxel>& records, const std::vector<int32_t>& index);
+  // Voxel records (on the volume's device) of the resident blocks `index` into the first
+  // index.size() blocks of `records`, and the way back.
+  void gather_records(std::span<const int32_t> index, Buffer<Voxel>& records) const;
+  void scatter_records(const Buffer<Voxel>& records, std::span<const int32_t> index);
+  // Records move between the pool and host memory through staging of at most kTransferBlocks
+  // blocks (12 MB), so streaming, saving or loading much of a map needs little memory beyond the
+  // pool: sink(j, voxels) receives slot slots[j]'s records, source(j) gives them.
+  static constexpr size_t kTransferBlocks = 1024;
+  template <class Sink>
+  void download_blocks(std::span<const int32_t> slots, Sink&& sink) const;
+  template <class Source>
+  void upload_blocks(std::span<const int32_t> slots, Source&& source);
+  void move_blocks(std::span<const int32_t> from, std::span<const int32_t> to);  // slot from[j] -> to[j]
+  void insert_block_ptrs(std::span<const BlockData* const> blocks);  // insert_blocks
+  // Moves the resident blocks whose key satisfies leave(key) to host memory.
+  template <class Leave>
+  int64_t stream_out_where(Leave leave);
+  int64_t stream_in_blocks(std::vector<const BlockData*> back);  // inserts them, then drops their host copies
 
   TsdfParams params_;
   Device device_;

@@ -12,6 +12,8 @@
 #include <iostream>
 #include <map>
 #include <numbers>
+#include <stdexcept>
+#include <tuple>
 
 namespace rrg {
 namespace {
@@ -112,6 +114,59 @@ TEST(TsdfMesh, SameMeshOnEveryDevice) {
     EXPECT_EQ(triangles_differ, 0u);
     EXPECT_LE(vertices_differ, cpu.vertices.size() / 1000);
     EXPECT_LE(worst, 1e-3f);
+  }
+}
+
+std::vector<Eigen::Vector3i> sorted_coords(std::vector<Eigen::Vector3i> c) {
+  std::sort(c.begin(), c.end(), [](const auto& a, const auto& b) { return std::tie(a.x(), a.y(), a.z()) < std::tie(b.x(), b.y(), b.z()); });
+  return c;
+}
+
+void expect_same_mesh(const TriangleMesh& a, const TriangleMesh& b) {
+  ASSERT_EQ(a.vertices.size(), b.vertices.size());
+  ASSERT_EQ(a.triangles.size(), b.triangles.size());
+  EXPECT_TRUE(a.vertices == b.vertices);
+  EXPECT_TRUE(a.colors == b.colors);
+  EXPECT_TRUE(a.plane_ids == b.plane_ids);
+  EXPECT_TRUE(a.triangles == b.triangles);
+}
+
+// A map larger than the device holds: the blocks streamed out to host memory are meshed in slabs
+// of consecutive block x without the pool ever holding more than the budget, into the very mesh of
+// the whole volume; the blocks resident before are resident after.
+TEST(TsdfMesh, StreamedExtractionMeshesEveryBlockWithinTheBudget) {
+  for (const Device& device : available_devices()) {
+    SCOPED_TRACE(device.to_string());
+    const TsdfVolume full = fused_sphere(device);
+    const TriangleMesh whole = extract_mesh(full);
+    const std::vector<BlockData> blocks = full.read_all_blocks();  // sorted by coordinate
+    // The budget: a sixth of the map, and at least the largest layer of block x with its +x layer.
+    std::map<int, size_t> layer;
+    for (const BlockData& b : blocks) ++layer[b.coord.x()];
+    size_t budget = blocks.size() / 6;
+    for (const auto& [x, n] : layer) budget = std::max(budget, n + (layer.count(x + 1) ? layer[x + 1] : 0));
+    ASSERT_LT(2 * budget, blocks.size());
+    // A volume whose pool never held more than the budget: a budget's worth of blocks inserted at
+    // a time, the previous ones streamed out first; the last group stays resident.
+    TsdfParams p = full.params();
+    p.initial_blocks = 1;
+    TsdfVolume v(p, device);
+    for (size_t i = 0; i < blocks.size(); i += budget) {
+      v.stream_out(v.block_coords());
+      v.insert_blocks(std::span(blocks).subspan(i, std::min(budget, blocks.size() - i)));
+    }
+    ASSERT_GT(v.num_host_blocks(), 0);
+    const auto resident = sorted_coords(v.block_coords());
+    const size_t device_bytes = v.memory().device_bytes;
+
+    expect_same_mesh(extract_mesh_streamed(v, int64_t(budget)), whole);
+    EXPECT_EQ(v.memory().device_bytes, device_bytes);  // neither the pool nor the hash grew
+    EXPECT_EQ(sorted_coords(v.block_coords()), resident);
+    EXPECT_EQ(size_t(v.num_blocks() + v.num_host_blocks()), blocks.size());
+    // A budget below one layer meshes a layer and its +x neighbour at a time: the same mesh.
+    expect_same_mesh(extract_mesh_streamed(v, 1), whole);
+    EXPECT_EQ(sorted_coords(v.block_coords()), resident);
+    EXPECT_THROW(extract_mesh_streamed(v, 0), std::invalid_argument);
   }
 }
 

@@ -114,6 +114,68 @@ TEST(TsdfStorage, StreamingOutAndBackInIsExact) {
   }
 }
 
+// Listed blocks move and nothing else: coordinates never allocated, out of the key range or
+// already in the other place are ignored.
+TEST(TsdfStorage, StreamingListedBlocksMovesExactlyThose) {
+  const test::Scene scene = test::sphere_scene({0, 0, 0}, 0.25f);
+  for (const Device& device : available_devices()) {
+    SCOPED_TRACE(device.to_string());
+    TsdfVolume v(params(), device);
+    test::fuse_scene(v, scene, kK, test::cameras_around({0, 0, 0}, 0.9f));
+    const auto before = test::flatten_voxels(v);
+    const int64_t total = v.num_blocks();
+    std::vector<Eigen::Vector3i> picked;
+    const auto coords = v.block_coords();
+    for (size_t i = 0; i < coords.size(); i += 3) picked.push_back(coords[i]);
+    std::vector<Eigen::Vector3i> listed = picked;
+    listed.push_back({1000, 1000, 1000});  // never allocated
+    listed.push_back({1 << 22, 0, 0});     // outside the key range
+    listed.push_back(picked.front());      // twice
+
+    EXPECT_EQ(v.stream_out(listed), int64_t(picked.size()));
+    EXPECT_EQ(v.stream_out(listed), 0);  // already out
+    EXPECT_EQ(v.num_blocks(), total - int64_t(picked.size()));
+    BlockSet out, expected;
+    for (const auto& c : v.host_block_coords()) out.insert({c.x(), c.y(), c.z()});
+    for (const auto& c : picked) expected.insert({c.x(), c.y(), c.z()});
+    EXPECT_EQ(out, expected);
+    for (const auto& c : v.block_coords()) EXPECT_FALSE(expected.count({c.x(), c.y(), c.z()}));
+    EXPECT_EQ(test::flatten_voxels(v), before);
+
+    const std::vector<Eigen::Vector3i> half(picked.begin(), picked.begin() + long(picked.size() / 2));
+    EXPECT_EQ(v.stream_in(half), int64_t(half.size()));
+    EXPECT_EQ(v.stream_in(listed), int64_t(picked.size() - half.size()));
+    EXPECT_EQ(v.num_host_blocks(), 0);
+    EXPECT_EQ(v.num_blocks(), total);
+    EXPECT_EQ(test::flatten_voxels(v), before);
+  }
+}
+
+// Records move between the pool and host memory 1024 blocks at a time (TsdfVolume's staging):
+// several thousand blocks out, part of them back, the rest back, and every voxel is where it was.
+TEST(TsdfStorage, StreamingMoreBlocksThanOneTransferIsExact) {
+  TsdfParams p = params();
+  p.voxel_size = 0.004f;
+  p.truncation = 0.016f;
+  const test::Scene scene = test::sphere_scene({0, 0, 0}, 0.5f);
+  for (const Device& device : available_devices()) {
+    SCOPED_TRACE(device.to_string());
+    TsdfVolume v(p, device);
+    test::fuse_scene(v, scene, kK, test::cameras_around({0, 0, 0}, 1.4f));
+    const auto before = test::flatten_voxels(v);
+    const int64_t total = v.num_blocks();
+    const int64_t moved = v.stream_out({0.5f, 0, 0}, 0.6f);  // keeps the +x side
+    EXPECT_GT(moved, 3 * 1024);
+    EXPECT_GT(v.num_blocks(), 1024);  // the compaction moves blocks too
+    EXPECT_EQ(test::flatten_voxels(v), before);
+    EXPECT_GT(v.stream_in({-0.3f, 0, 0}, 0.4f), 1024);
+    EXPECT_EQ(test::flatten_voxels(v), before);
+    v.stream_in_all();
+    EXPECT_EQ(v.num_blocks(), total);
+    EXPECT_EQ(test::flatten_voxels(v), before);
+  }
+}
+
 TEST(TsdfStorage, IntegrationBringsStreamedOutBlocksBack) {
   const test::Scene scene = test::sphere_scene({0, 0, 0}, 0.25f);
   const auto poses = test::cameras_around({0, 0, 0}, 0.9f);
