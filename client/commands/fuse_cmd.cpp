@@ -13,6 +13,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -47,8 +48,14 @@ void run_fuse(const FuseOptions& o) {
   spdlog::info("fuse: {} ({} frames, {}x{}) on {}, {}", o.dataset, dataset->size(), K.width, K.height,
                device.to_string(), params.to_string());
 
-  double t_load = 0, t_fuse = 0, t_raycast = 0;
+  if (o.stream_radius > 0.0f && o.stream_radius < view_reach(K, params))
+    spdlog::warn("fuse: --stream-radius {:.2f} m is less than the {:.2f} m a frame reaches (max depth {:.2f} m along "
+                 "the image corners' rays, plus the band): blocks in view will be streamed out after every frame and "
+                 "back with the next; use at least {:.2f} m",
+                 o.stream_radius, view_reach(K, params), params.max_depth, view_reach(K, params));
+  double t_load = 0, t_fuse = 0, t_raycast = 0, t_stream = 0;
   size_t fused = 0, skipped = 0;
+  int64_t peak_resident = 0;  // most blocks resident at once (right after a frame's fusion)
   const StopOnSignal signals;
   bool interrupted = false;
   for (size_t i = 0; i < dataset->size(); i += size_t(o.every)) {
@@ -76,7 +83,12 @@ void run_fuse(const FuseOptions& o) {
       const RaycastResult r = raycast(volume, K, T_wc);
       t_raycast += ms_since(t0);
     }
-    if (o.stream_radius > 0.0f) volume.stream_out(T_wc.translation(), o.stream_radius);
+    peak_resident = std::max(peak_resident, volume.num_blocks());
+    if (o.stream_radius > 0.0f) {
+      t0 = Clock::now();
+      volume.stream_out(T_wc.translation(), o.stream_radius);
+      t_stream += ms_since(t0);
+    }
     ++fused;
     if (fused % 10 == 0)
       spdlog::info("fuse: {} frames fused (frame {}), {} blocks on {}, {} in host memory", fused, i,
@@ -84,10 +96,11 @@ void run_fuse(const FuseOptions& o) {
   }
   if (fused == 0) throw std::runtime_error("fuse: no frame with a pose was fused");
   if (skipped > 0) spdlog::warn("fuse: {} frames without a pose skipped", skipped);
-  volume.stream_in_all();
 
+  // With streaming the map may not fit the device at once: mesh it in slabs of no more blocks than
+  // fusion held resident (the same mesh as meshing it whole).
   auto t0 = Clock::now();
-  const TriangleMesh mesh = extract_mesh(volume);
+  const TriangleMesh mesh = extract_mesh_streamed(volume, std::max<int64_t>(peak_resident, 1));
   const double t_extract = ms_since(t0);
   if (mesh.triangles.empty()) throw std::runtime_error("fuse: the mesh is empty (no surface in the volume)");
   t0 = Clock::now();
@@ -96,11 +109,17 @@ void run_fuse(const FuseOptions& o) {
   if (!o.save.empty()) save_volume(volume, o.save);
 
   const MemoryUsage mem = volume.memory();
-  std::printf("fused %zu frames into %lld blocks (%.1f MB on %s)\n", fused, (long long)volume.num_blocks(),
-              double(mem.device_bytes) / 1e6, device.to_string().c_str());
+  std::printf("fused %zu frames into %lld blocks (%.1f MB on %s)\n", fused,
+              (long long)(volume.num_blocks() + volume.num_host_blocks()), double(mem.device_bytes) / 1e6,
+              device.to_string().c_str());
+  if (o.stream_radius > 0.0f)
+    std::printf("streaming (radius %.2f m): at most %lld blocks resident, %lld in host memory at the end (%.1f MB)\n",
+                o.stream_radius, (long long)peak_resident, (long long)volume.num_host_blocks(),
+                double(mem.host_bytes) / 1e6);
   std::printf("mesh: %zu vertices, %zu triangles -> %s\n", mesh.vertices.size(), mesh.triangles.size(), o.out.c_str());
   std::printf("timing: load %.2f ms/frame, fusion %.2f ms/frame", t_load / double(fused), t_fuse / double(fused));
   if (o.raycast) std::printf(", raycast %.2f ms/frame", t_raycast / double(fused));
+  if (o.stream_radius > 0.0f) std::printf(", streaming %.2f ms/frame", t_stream / double(fused));
   std::printf(", extraction %.1f ms, ply write %.1f ms\n", t_extract, t_write);
   if (interrupted) signals.finish_interrupted(fused);
 }
@@ -124,7 +143,9 @@ void register_fuse_command(CLI::App& app) {
   cmd->add_option("--max-frames", opts->max_frames, "stop after N fused frames (0 = all)")->capture_default_str();
   cmd->add_option("--save", opts->save, "also write the volume (.tsdf)");
   cmd->add_option("--stream-radius", opts->stream_radius,
-                  "move blocks farther than R metres from the camera to host memory (0 = off)");
+                  "move blocks farther than R metres from the camera to host memory after each frame (0 = off); "
+                  "the mesh is then made in slabs that fit the device")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--raycast", opts->raycast, "raycast every fused frame from its pose (timing)");
   io::add_dataset_flags(*cmd, opts->flags);
   cmd->callback([opts] { run_fuse(*opts); });

@@ -14,6 +14,11 @@
 namespace rrg {
 namespace {
 
+std::string file_bytes(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
+}
+
 TEST(TsdfCli, FusesASyntheticSequenceIntoAnAccurateMesh) {
   const test::TempDir tmp("tsdf-cli");
   const std::string dir = (tmp / "office").string();
@@ -26,6 +31,23 @@ TEST(TsdfCli, FusesASyntheticSequenceIntoAnAccurateMesh) {
   EXPECT_NE(fuse.output.find("fusion"), std::string::npos) << fuse.output;  // timing summary
   EXPECT_EQ(load_volume(vol, Device::cpu()).version(), 20u);
   EXPECT_EQ(load_volume(vol, Device::cpu()).params().band_sigmas, 3.0f);  // the noise band by default
+
+  // Streaming: with blocks farther than 1 m from the camera moved to host memory after each frame
+  // (most of the room), fusion and the slab-wise meshing give the same mesh and volume, byte for byte.
+  const std::string mesh_s = (tmp / "mesh_s.ply").string(), vol_s = (tmp / "v_s.tsdf").string();
+  const auto streamed = test::run_rrg("fuse " + dir + " --out " + mesh_s + " --voxel 0.02 --device cpu --save " + vol_s +
+                                      " --stream-radius 1.0");
+  ASSERT_EQ(streamed.exit_code, 0) << streamed.output;
+  std::smatch b;
+  ASSERT_TRUE(std::regex_search(fuse.output, b, std::regex(R"(into (\d+) blocks)"))) << fuse.output;
+  const long blocks = std::stol(b[1]);
+  EXPECT_NE(streamed.output.find("into " + b[1].str() + " blocks"), std::string::npos) << streamed.output;
+  ASSERT_TRUE(std::regex_search(streamed.output, b, std::regex(R"(at most (\d+) blocks resident, (\d+) in host)")))
+      << streamed.output;
+  EXPECT_LT(std::stol(b[1]), blocks) << streamed.output;      // never the whole map at once
+  EXPECT_GT(std::stol(b[2]), blocks / 2) << streamed.output;  // most of it in host memory at the end
+  EXPECT_EQ(file_bytes(mesh_s), file_bytes(mesh));
+  EXPECT_EQ(file_bytes(vol_s), file_bytes(vol));
 
   // Accuracy is measured to samples of the whole-room ground-truth mesh (~120 m^2), so the sample
   // spacing sqrt(A/N) sets a floor: 1M samples give ~1 cm spacing, a mean floor of ~0.5 cm, far
@@ -78,6 +100,10 @@ TEST(TsdfCli, ErrorsExitWithAMessage) {
                                       " --out " + (tmp / "m.ply").string() + " --band-sigmas -1");
   EXPECT_NE(bad_band.exit_code, 0) << bad_band.output;
   EXPECT_NE(bad_band.output.find("--band-sigmas"), std::string::npos) << bad_band.output;
+  const auto bad_radius = test::run_rrg("fuse " + (test::test_data_dir() / "7scenes_mini").string() +
+                                        " --out " + (tmp / "m.ply").string() + " --stream-radius -1");
+  EXPECT_NE(bad_radius.exit_code, 0) << bad_radius.output;
+  EXPECT_NE(bad_radius.output.find("--stream-radius"), std::string::npos) << bad_radius.output;
   EXPECT_FALSE(std::filesystem::exists(tmp / "m.ply"));
 }
 
