@@ -9,6 +9,8 @@ const std::vector<PresetInfo>& preset_list() {
       {"living_room", "glossy tiled floor, glossy TV screen and coffee table, sofa, shelves, lamp, posters"},
       {"mirror_room", "large wall mirror (F0 0.9) and a glossy wooden floor reflecting armchair, shelf, lamp"},
       {"office", "matte control scene (F0 = 0 everywhere): desks, chairs, shelves, whiteboards, carpet"},
+      {"open_plan", "12 x 9 m open-plan flat (108 m²): polished concrete floor, lounge with glossy TV and table, "
+                    "kitchen with a glossy island, dining table, study alcove, hall"},
   };
   return kPresets;
 }
@@ -23,6 +25,7 @@ SceneSpec make_preset(const std::string& name, uint32_t seed) {
   if (name == "living_room") return make_living_room(seed);
   if (name == "mirror_room") return make_mirror_room(seed);
   if (name == "office") return make_office(seed);
+  if (name == "open_plan") return make_open_plan(seed);
   throw std::invalid_argument("unknown preset '" + name + "' (valid presets: " + preset_names() + ")");
 }
 

@@ -1,6 +1,6 @@
 #pragma once
-// The scene presets of `rrg synth`: rooms about 5 x 4 x 2.7 m (world z up, floor at z = 0) with
-// planar reflective surfaces, each with a hand-placed closed camera loop.
+// The scene presets of `rrg synth`: rooms about 5 x 4 x 2.7 m and a 12 x 9 x 2.8 m flat (world z up,
+// floor at z = 0) with planar reflective surfaces, each with a hand-placed closed camera loop.
 #include "core/synth/camera_path.h"
 #include "core/synth/scene.h"
 
@@ -21,7 +21,7 @@ struct SceneSpec {
 
 // All presets, in a fixed order.
 const std::vector<PresetInfo>& preset_list();
-// "living_room, mirror_room, office" (for error messages and help).
+// "living_room, mirror_room, office, open_plan" (for error messages and help).
 std::string preset_names();
 // Builds a preset; seed varies textures only. Throws std::invalid_argument naming the valid
 // presets for an unknown name.
@@ -31,5 +31,6 @@ SceneSpec make_preset(const std::string& name, uint32_t seed);
 SceneSpec make_living_room(uint32_t seed);
 SceneSpec make_mirror_room(uint32_t seed);
 SceneSpec make_office(uint32_t seed);
+SceneSpec make_open_plan(uint32_t seed);
 
 }  // namespace rrg::synth

@@ -228,7 +228,7 @@ TEST(SynthCli, ErrorsAndList) {
   const auto bad = run_rrg("synth --preset kitchen --frames 2 --out " + (tmp / "x").string());
   EXPECT_EQ(bad.exit_code, 1);
   EXPECT_NE(bad.output.find("unknown preset 'kitchen'"), std::string::npos) << bad.output;
-  EXPECT_NE(bad.output.find("living_room, mirror_room, office"), std::string::npos) << bad.output;
+  EXPECT_NE(bad.output.find("living_room, mirror_room, office, open_plan"), std::string::npos) << bad.output;
   EXPECT_FALSE(fs::exists(tmp / "x")) << "nothing written on a bad preset";
   const auto zero = run_rrg("synth --frames 0 --out " + (tmp / "y").string());
   EXPECT_EQ(zero.exit_code, 1);
