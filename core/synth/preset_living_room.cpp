@@ -11,9 +11,6 @@ using Eigen::Vector3f;
 
 SceneSpec make_living_room(uint32_t seed) {
   SceneBuilder b("living_room", preset_list()[0].description, seed);
-  auto tex = [](TextureKind k, Color a, Color bb, Color c, float scale, float param = 0.004f) {
-    return Texture{k, a, bb, c, scale, param};
-  };
   // Materials: F0 > 0 only on the floor, the TV screen and the coffee table top.
   const auto floor = b.material("marble_tiles", tex(TextureKind::Tiles, srgb(168, 160, 148), srgb(120, 112, 104),
                                                     srgb(70, 66, 62), 0.5f, 0.005f), 0.25f, 0.03f);
@@ -32,13 +29,9 @@ SceneSpec make_living_room(uint32_t seed) {
   const auto screen = b.material("tv_screen", tex(TextureKind::Screen, srgb(40, 90, 160), srgb(200, 120, 60),
                                                   srgb(8, 8, 10), 1.0f), 0.12f, 0.0f);
   const auto rug = b.material("rug", tex(TextureKind::Carpet, srgb(150, 40, 40), srgb(220, 190, 140), Z, 0.25f));
-  const auto shade = b.emitter("lamp_shade", tex(TextureKind::Fabric, srgb(250, 235, 200), srgb(240, 220, 180), Z, 0.1f),
-                               srgb(255, 220, 160) * 0.9f);
-  const auto panel = b.emitter("light_panel", tex(TextureKind::Solid, srgb(250, 250, 245), Z, Z, 0.1f),
-                               Color(1.2f, 1.15f, 1.05f));
-  const auto pot = b.material("terracotta", tex(TextureKind::Plaster, srgb(180, 90, 50), Z, Z, 0.2f));
-  const auto leaves = b.material("leaves", tex(TextureKind::Leaves, srgb(40, 110, 40), srgb(20, 60, 25), Z, 0.1f));
-  const auto door = b.material("door", tex(TextureKind::Wood, srgb(200, 180, 150), srgb(170, 150, 120), srgb(90, 80, 60), 0.9f));
+  const HomeMaterials home = home_materials(b);
+  const auto shade = home.lamp_shade, panel = home.light_panel, pot = home.terracotta, leaves = home.leaves,
+             door = home.door;
   auto poster = [&](const std::string& n, Color a, Color c2) {
     return b.material(n, tex(TextureKind::Poster, a, c2, srgb(20, 20, 20), 1.0f));
   };

@@ -8,9 +8,6 @@ namespace rrg::synth {
 SceneSpec make_mirror_room(uint32_t seed) {
   SceneBuilder b("mirror_room", preset_list()[1].description, seed);
   const Color Z = Color::Zero();
-  auto tex = [](TextureKind k, Color a, Color bb, Color c, float scale, float param = 0.004f) {
-    return Texture{k, a, bb, c, scale, param};
-  };
   const auto floor = b.material("glossy_planks", tex(TextureKind::Wood, srgb(196, 150, 104), srgb(150, 104, 66),
                                                      srgb(70, 48, 30), 0.18f), 0.2f, 0.03f);
   const auto walls = b.material("wallpaper", tex(TextureKind::Wallpaper, srgb(190, 204, 196), srgb(160, 180, 172),

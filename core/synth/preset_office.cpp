@@ -10,9 +10,6 @@ namespace rrg::synth {
 SceneSpec make_office(uint32_t seed) {
   SceneBuilder b("office", preset_list()[2].description, seed);
   const Color Z = Color::Zero();
-  auto tex = [](TextureKind k, Color a, Color bb, Color c, float scale, float param = 0.004f) {
-    return Texture{k, a, bb, c, scale, param};
-  };
   const auto floor = b.material("carpet_tiles", tex(TextureKind::Carpet, srgb(90, 100, 115), srgb(130, 140, 150), Z, 0.5f));
   const auto walls = b.material("painted_wall", tex(TextureKind::Wallpaper, srgb(215, 215, 208), srgb(200, 200, 192),
                                                     srgb(170, 170, 165), 0.4f));

@@ -13,9 +13,6 @@ namespace rrg::synth {
 SceneSpec make_open_plan(uint32_t seed) {
   SceneBuilder b("open_plan", preset_list()[3].description, seed);
   const Color Z = Color::Zero();
-  auto tex = [](TextureKind k, Color a, Color bb, Color c, float scale, float param = 0.004f) {
-    return Texture{k, a, bb, c, scale, param};
-  };
   // Materials: F0 > 0 on the floor, the TV screen, the coffee table and the island's worktop.
   const auto floor = b.material("polished_concrete", tex(TextureKind::Plaster, srgb(150, 148, 142), srgb(120, 118, 112),
                                                          srgb(90, 88, 84), 0.8f), 0.15f, 0.04f);
@@ -41,13 +38,9 @@ SceneSpec make_open_plan(uint32_t seed) {
                                                       srgb(15, 15, 18), 1.0f));
   const auto seat = b.material("seat_fabric", tex(TextureKind::Fabric, srgb(40, 60, 90), srgb(25, 40, 65), Z, 0.1f));
   const auto rug = b.material("rug", tex(TextureKind::Carpet, srgb(60, 70, 130), srgb(200, 190, 150), Z, 0.25f));
-  const auto shade = b.emitter("lamp_shade", tex(TextureKind::Fabric, srgb(250, 235, 200), srgb(240, 220, 180), Z, 0.1f),
-                               srgb(255, 220, 160) * 0.9f);
-  const auto panel = b.emitter("light_panel", tex(TextureKind::Solid, srgb(250, 250, 245), Z, Z, 0.1f),
-                               Color(1.2f, 1.15f, 1.05f));
-  const auto pot = b.material("terracotta", tex(TextureKind::Plaster, srgb(180, 90, 50), Z, Z, 0.2f));
-  const auto leaves = b.material("leaves", tex(TextureKind::Leaves, srgb(40, 110, 40), srgb(20, 60, 25), Z, 0.1f));
-  const auto door = b.material("door", tex(TextureKind::Wood, srgb(200, 180, 150), srgb(170, 150, 120), srgb(90, 80, 60), 0.9f));
+  const HomeMaterials home = home_materials(b);
+  const auto shade = home.lamp_shade, panel = home.light_panel, pot = home.terracotta, leaves = home.leaves,
+             door = home.door;
   auto poster = [&](const std::string& n, Color a, Color c2) {
     return b.material(n, tex(TextureKind::Poster, a, c2, srgb(20, 20, 20), 1.0f));
   };

@@ -235,6 +235,19 @@ void SceneBuilder::plant(const std::string& name, const Vector2f& xy, float r, u
   sphere(name + "_leaves", {xy.x(), xy.y(), 2.0f * r + 1.3f * r}, 1.5f * r, leaves, Category::Plant);
 }
 
+HomeMaterials home_materials(SceneBuilder& b) {
+  const Color Z = Color::Zero();
+  HomeMaterials m{};
+  m.lamp_shade = b.emitter("lamp_shade", tex(TextureKind::Fabric, srgb(250, 235, 200), srgb(240, 220, 180), Z, 0.1f),
+                           srgb(255, 220, 160) * 0.9f);
+  m.light_panel = b.emitter("light_panel", tex(TextureKind::Solid, srgb(250, 250, 245), Z, Z, 0.1f),
+                            Color(1.2f, 1.15f, 1.05f));
+  m.terracotta = b.material("terracotta", tex(TextureKind::Plaster, srgb(180, 90, 50), Z, Z, 0.2f));
+  m.leaves = b.material("leaves", tex(TextureKind::Leaves, srgb(40, 110, 40), srgb(20, 60, 25), Z, 0.1f));
+  m.door = b.material("door", tex(TextureKind::Wood, srgb(200, 180, 150), srgb(170, 150, 120), srgb(90, 80, 60), 0.9f));
+  return m;
+}
+
 Scene SceneBuilder::finish() {
   for (size_t i = 0; i < scene_.primitives.size(); ++i)
     scene_.primitives[i].seed = hash3(seed_, uint32_t(i), 0x5eedu);

@@ -65,6 +65,18 @@ class SceneBuilder {
   uint32_t seed_;
 };
 
+// Texture shorthand for presets: kind, three colours, scale and the kind's parameter.
+inline Texture tex(TextureKind kind, Color a, Color b, Color c, float scale, float param = 0.004f) {
+  return Texture{kind, a, b, c, scale, param};
+}
+
+// Materials the furnished presets (living_room, open_plan) share: a lamp shade and a ceiling panel
+// that glow, terracotta pots, leaves and a wooden door. Registered in this order.
+struct HomeMaterials {
+  uint16_t lamp_shade, light_panel, terracotta, leaves, door;
+};
+HomeMaterials home_materials(SceneBuilder& b);
+
 // Rotation about z by yaw degrees, as a world -> local matrix.
 Eigen::Matrix3f yaw_world_to_local(float yaw_deg);
 
