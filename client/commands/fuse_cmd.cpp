@@ -48,11 +48,11 @@ void run_fuse(const FuseOptions& o) {
   spdlog::info("fuse: {} ({} frames, {}x{}) on {}, {}", o.dataset, dataset->size(), K.width, K.height,
                device.to_string(), params.to_string());
 
-  if (o.stream_radius > 0.0f && o.stream_radius < view_reach(K, params))
+  if (const float reach = view_reach(K, params); o.stream_radius > 0.0f && o.stream_radius < reach)
     spdlog::warn("fuse: --stream-radius {:.2f} m is less than the {:.2f} m a frame reaches (max depth {:.2f} m along "
                  "the image corners' rays, plus the band): blocks in view will be streamed out after every frame and "
                  "back with the next; use at least {:.2f} m",
-                 o.stream_radius, view_reach(K, params), params.max_depth, view_reach(K, params));
+                 o.stream_radius, reach, params.max_depth, reach);
   double t_load = 0, t_fuse = 0, t_raycast = 0, t_stream = 0;
   size_t fused = 0, skipped = 0;
   int64_t peak_resident = 0;  // most blocks resident at once (right after a frame's fusion)

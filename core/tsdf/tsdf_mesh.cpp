@@ -200,7 +200,11 @@ TriangleMesh extract_mesh_streamed(TsdfVolume& volume, int64_t max_resident_bloc
     size_t end = layer_end(begin);
     while (end < all.size() && layer_end(end) - begin + margin(layer_end(end)) <= budget) end = layer_end(end);
     const size_t with_margin = end + margin(end);
-    volume.stream_out(volume.block_coords());
+    // Out goes what lies before this slab; the previous slab's margin layer is this slab's first.
+    std::vector<Eigen::Vector3i> before;
+    for (const Eigen::Vector3i& c : volume.block_coords())
+      if (c.x() < all[begin].x()) before.push_back(c);
+    volume.stream_out(before);
     volume.stream_in(std::span(all).subspan(begin, with_margin - begin));
     peak = std::max(peak, size_t(volume.num_blocks()));
     const std::vector<Eigen::Vector3i> pool = volume.block_coords();

@@ -358,11 +358,8 @@ int64_t TsdfVolume::stream_in_blocks(std::vector<const BlockData*> back) {
   std::sort(back.begin(), back.end(), [&](const BlockData* a, const BlockData* b) { return key_of(a) < key_of(b); });
   back.erase(std::unique(back.begin(), back.end()), back.end());
   insert_block_ptrs(back);
-  std::vector<uint64_t> keys;
-  keys.reserve(back.size());
-  for (const BlockData* b : back) keys.push_back(key_of(b));
-  for (uint64_t k : keys) host_blocks_.erase(k);
-  return int64_t(keys.size());
+  for (const BlockData* b : back) host_blocks_.erase(key_of(b));  // the key is read before b goes
+  return int64_t(back.size());
 }
 
 std::vector<Eigen::Vector3i> TsdfVolume::host_block_coords() const {
