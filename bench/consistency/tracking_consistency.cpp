@@ -131,7 +131,7 @@ int main(int argc, char** argv) {
       }
       if (keyframes.empty() || needs_keyframe(keyframes.back().T_wc, T_gt.cast<float>(), params.keyframes))
         keyframes.add(make_keyframe(keyframe_id++, i, T_gt.cast<float>(), features));
-      integrate(volume, *tracker.preprocessed_depth(), color, K, T_gt.cast<float>());
+      integrate(volume, depth, color, K, T_gt.cast<float>(), nullptr, tracker.normal_depth());
       model.invalidate();
       T_prev_gt = T_gt;
       if ((i / size_t(skip)) % 50 == 0) spdlog::info("frame {} / {}", i, n);

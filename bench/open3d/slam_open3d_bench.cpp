@@ -3,7 +3,7 @@
 // same frames from any dataset our readers open (core/io), interleaved frame by frame:
 //   ours:   the loop of `rrg track` (client/commands/track_cmd.cpp), with the same library calls:
 //           TsdfModelSource::model_at(T_{k−1}) (raycast), Tracker::track (preprocess → ICP → ORB),
-//           integrate() of Tracker::preprocessed_depth() at the tracked pose unless lost;
+//           integrate() of the depth with Tracker::normal_depth()'s normals at the tracked pose unless lost;
 //   Open3D: the loop of its DenseSLAM example (examples/cpp/DenseSLAM.cpp): SynthesizeModelFrame at
 //           T_{k−1} (raycast of the last frame's frustum blocks, no colour), TrackFrameToModel
 //           (point-to-plane multi-scale odometry, {6, 3, 1} iterations, depth_diff), the example's
@@ -296,8 +296,7 @@ void run(const Options& o) {
       ours_orb += r.ms_orb;
       if (r.state != rrg::TrackingState::Lost) {
         t0 = now();
-        const rrg::DeviceImage<float>* fused = tracker.preprocessed_depth();
-        rrg::integrate(volume, fused ? *fused : depth, color, K, r.T_wc);
+        rrg::integrate(volume, depth, color, K, r.T_wc, nullptr, tracker.normal_depth());
         model.invalidate();
         t1 = now();
         ours_fuse.add(t0, t1);

@@ -103,9 +103,8 @@ void run_track(const TrackOptions& o) {
     double ms_fuse = 0;
     if (r.state != TrackingState::Lost) {
       t0 = Clock::now();
-      // The preprocessed D_k (bilateral filter) unless asked otherwise: see Tracker::preprocessed_depth().
-      const DeviceImage<float>* fused = o.fuse_raw ? &depth : tracker.preprocessed_depth();
-      integrate(volume, fused ? *fused : depth, color, K, r.T_wc);
+      // The sensor's D_k with the filtered depth's normals unless asked otherwise: see Tracker::normal_depth().
+      integrate(volume, depth, color, K, r.T_wc, nullptr, o.fuse_raw ? nullptr : tracker.normal_depth());
       model.invalidate();
       ms_fuse = ms_since(t0);
     }
@@ -211,7 +210,7 @@ void register_track_command(CLI::App& app) {
   cmd->add_flag("--no-noise-weighting", opts->no_noise_weighting,
                 "weigh every ICP pair alike instead of by the sensor's depth noise at its depth (ablation)");
   cmd->add_flag("--fuse-raw-depth", opts->fuse_raw,
-                "fuse the raw depth instead of the preprocessed (bilateral-filtered) one (ablation)");
+                "fuse the raw depth with its own normals instead of the bilateral-filtered depth's (ablation)");
   cmd->add_flag("--identity-start", opts->identity_start, "start at the identity instead of the first ground-truth pose");
   io::add_dataset_flags(*cmd, opts->flags);
   cmd->callback([opts] { run_track(*opts); });

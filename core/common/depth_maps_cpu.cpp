@@ -3,9 +3,9 @@
 
 namespace rrg::kernel {
 
-void vertex_normal_maps_cpu(ImageView<const float> depth, const Intrinsics& K,
+void vertex_normal_maps_cpu(ImageView<const float> depth, ImageView<const float> normal_depth, const Intrinsics& K,
                             ImageView<Eigen::Vector3f> vertices, ImageView<Eigen::Vector3f> normals) {
-  vertex_normal_maps(CpuBackend{}, depth, K, vertices, normals);
+  vertex_normal_maps(CpuBackend{}, depth, normal_depth, K, vertices, normals);
 }
 
 }  // namespace rrg::kernel

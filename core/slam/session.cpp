@@ -474,7 +474,9 @@ FrameReport Session::process(const SessionFrame& frame) {
   // showed again then fill what is still lost in their footprints (glass the segmenter missed), as
   // on frames without masks. (A region a mask filled is not applied over it: its footprint, dilated
   // by a cell, would press the wall around the glass onto a plane fitted a little in front of it.)
-  std::optional<DeviceImage<float>> fuse_override;  // the filtered depth, filled
+  // What fusion takes on a filled frame: the frame with the fill written in, and the filtered
+  // depth its normals come from, filled the same way.
+  std::optional<DeviceImage<float>> fuse_depth, fuse_normal_depth;
   if (report.state != TrackingState::Lost && fill_pending) {
     const auto tf = Clock::now();
     const ReflectiveFillParams params = s.config.planes.fill_params();
@@ -507,14 +509,15 @@ FrameReport Session::process(const SessionFrame& frame) {
     report.filled_pixels += pixels;
     if (report.filled_pixels > 0) {
       filled = std::move(carried);
-      D_k = &filled;
-      if (const DeviceImage<float>* f = s.config.gt_poses ? nullptr : s.tracker.preprocessed_depth()) {
-        DepthImage host = f->to_host();
-        copy_filled_depth(filled, written, host);
-        fuse_override = DeviceImage<float>::from_host(host, s.config.device);
-      } else {
-        fuse_override = DeviceImage<float>::from_host(filled, s.config.device);
+      fuse_depth = DeviceImage<float>::from_host(filled, s.config.device);
+      // The filtered depth is of what tracking saw: pixels it left out and the fill did not write
+      // have no normal there, so they are not fused (what the glass showed).
+      if (const DeviceImage<float>* f = s.config.gt_poses ? nullptr : s.tracker.normal_depth()) {
+        DepthImage smooth = f->to_host();
+        copy_filled_depth(filled, written, smooth);
+        fuse_normal_depth = DeviceImage<float>::from_host(smooth, s.config.device);
       }
+      D_k = &filled;
     }
     report.times.identify += ms_since(tf);
   }
@@ -532,12 +535,16 @@ FrameReport Session::process(const SessionFrame& frame) {
     {
       std::unique_lock lock(s.volume_mutex);  // the one writer
       const ReflectionObservation obs{&plane_ids, &mask, s.remap, report.exposure_gain};  // remap: this thread's
-      // D_k after the bilateral filter: at fine resolutions the raw depth's noise exceeds the pixel
-      // spacing and fusion's normals (point-to-plane sdf, grazing test) would drop the surface
-      // (docs/tracking.md); with given poses nothing was preprocessed and the raw depth is fused.
-      const DeviceImage<float>* filtered = s.config.gt_poses ? nullptr : s.tracker.preprocessed_depth();
-      integrate(s.volume, fuse_override ? *fuse_override : (filtered ? *filtered : depth), color, s.K, report.T_wc,
-                identify ? &obs : nullptr);
+      // The sensor's D_k with the normals of the bilateral-filtered one: at fine resolutions the raw
+      // depth's noise exceeds the pixel spacing and its normals (point-to-plane sdf, grazing test)
+      // would drop the surface, while filtered positions differ from view to view (docs/tracking.md
+      // "Positions from the sensor, normals from the filter"); with given poses nothing was
+      // preprocessed and the depth's own normals are used.
+      const DeviceImage<float>* normal_depth =
+          fuse_depth ? (fuse_normal_depth ? &*fuse_normal_depth : nullptr)
+                     : (s.config.gt_poses ? nullptr : s.tracker.normal_depth());
+      integrate(s.volume, fuse_depth ? *fuse_depth : depth, color, s.K, report.T_wc, identify ? &obs : nullptr,
+                normal_depth);
     }
     s.model.invalidate();
     report.times.fuse = ms_since(tf);

@@ -38,18 +38,21 @@ FramePyramid build_pyramid(const DeviceImage<float>& depth, const Intrinsics& K,
   if (params.levels < 1) throw std::invalid_argument("build_pyramid: levels must be >= 1");
   FramePyramid pyramid;
   DeviceImage<float> d0(depth.width(), depth.height(), depth.device());
+  mem::copy(d0.buffer().data(), d0.device(), depth.buffer().data(), depth.device(), depth.buffer().size() * sizeof(float));
+  DeviceImage<float> f0;
   if (params.bilateral)
-    d0 = bilateral_filter_depth(depth, params.bilateral_radius, params.sigma_space_px, params.sigma_depth_m);
-  else
-    mem::copy(d0.buffer().data(), d0.device(), depth.buffer().data(), depth.device(), depth.buffer().size() * sizeof(float));
-  pyramid.levels.push_back({K, std::move(d0), {}});
+    f0 = bilateral_filter_depth(depth, params.bilateral_radius, params.sigma_space_px, params.sigma_depth_m);
+  pyramid.levels.push_back({K, std::move(d0), std::move(f0), {}});
   for (int l = 1; l < params.levels; ++l) {
     const PyramidLevel& prev = pyramid.levels.back();
     DeviceImage<float> half = downsample_depth(prev.depth, params.sigma_depth_m);
+    DeviceImage<float> half_filtered;
+    if (prev.filtered.width() > 0) half_filtered = downsample_depth(prev.filtered, params.sigma_depth_m);
     const Intrinsics Kl = half_intrinsics(prev.K, half.width(), half.height());
-    pyramid.levels.push_back({Kl, std::move(half), {}});
+    pyramid.levels.push_back({Kl, std::move(half), std::move(half_filtered), {}});
   }
-  for (PyramidLevel& level : pyramid.levels) level.maps = compute_vertex_normal_maps(level.depth, level.K);
+  for (PyramidLevel& level : pyramid.levels)
+    level.maps = compute_vertex_normal_maps(level.depth, level.normal_depth(), level.K);
   return pyramid;
 }
 

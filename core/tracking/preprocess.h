@@ -2,6 +2,10 @@
 // Input preprocessing of tracking (paper §4.1.1): optional bilateral filter of D_k, a depth
 // pyramid (2x2 block averages that skip depth discontinuities), and per level the local vertex map
 // V_k^l and normal map N_k^l (core/common/depth_maps.h). Runs on the device the depth lives on.
+// V_k^l comes from the sensor's depth and N_k^l from the filtered one: the filter smooths in pixels,
+// so it rounds a crease over more metres at 4 m than at 1 m, and filtered positions disagree from
+// view to view (a 0.6 % scale drift of ICP in a 12 m room); its normals only tilt there
+// (docs/tracking.md "Positions from the sensor, normals from the filter").
 #include "core/common/buffer.h"
 #include "core/common/camera.h"
 #include "core/common/depth_maps.h"
@@ -13,8 +17,12 @@ namespace rrg {
 
 struct PyramidLevel {
   Intrinsics K;                    // K scaled to this level
-  DeviceImage<float> depth;        // metres, 0 = invalid
-  VertexNormalMaps maps;           // V_k^l, N_k^l (camera frame)
+  DeviceImage<float> depth;        // metres, 0 = invalid: the sensor's D_k (level 0) and its averages
+  DeviceImage<float> filtered;     // the bilateral-filtered D_k and its averages; empty without the filter
+  VertexNormalMaps maps;           // V_k^l from depth, N_k^l from filtered (from depth without it), camera frame
+
+  // The depth N_k^l is computed from: filtered, or depth when the filter is off.
+  const DeviceImage<float>& normal_depth() const { return filtered.width() > 0 ? filtered : depth; }
 };
 
 struct FramePyramid {

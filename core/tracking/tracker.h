@@ -83,13 +83,15 @@ class Tracker {
   // R_k^track in icp+orb+mask mode (required there). Throws std::invalid_argument on size mismatch.
   TrackResult track(const TrackInput& input, ModelSource& model, MaskSource* masks);
 
-  // D_k after preprocessing (bilateral filter) of the last frame given to track(), on the tracker's
-  // device: the depth to fuse. At fine resolutions (640x480) Kinect-like noise (σ ≈ 2 cm at 3.5 m)
-  // exceeds the pixel spacing (7 mm), so normals from central differences of the raw depth are
-  // noise; the TSDF's point-to-plane sdf and its grazing-angle test then drop half the surface and
-  // ICP loses track (docs/tracking.md). Null before the first frame.
-  const DeviceImage<float>* preprocessed_depth() const {
-    return pyramid_.levels.empty() ? nullptr : &pyramid_.levels[0].depth;
+  // The bilateral-filtered D_k of the last frame given to track() (its depth when the filter is
+  // off), on the tracker's device: the depth fusion should take its normals from, while it fuses
+  // the sensor's depth (integrate(..., normal_depth)). At fine resolutions (640x480) Kinect-like
+  // noise (σ ≈ 2 cm at 3.5 m) exceeds the pixel spacing (7 mm), so normals from central
+  // differences of the raw depth are noise; the TSDF's point-to-plane sdf and its grazing-angle
+  // test then drop half the surface and ICP loses track. Fusing the filtered depth itself instead
+  // biases the map by view (docs/tracking.md). Null before the first frame.
+  const DeviceImage<float>* normal_depth() const {
+    return pyramid_.levels.empty() ? nullptr : &pyramid_.levels[0].normal_depth();
   }
   TrackingState state() const { return state_; }
   const KeyframeSet& keyframes() const { return keyframes_; }

@@ -24,11 +24,13 @@ void check_image(const DeviceImage<T>& image, const char* what, const Intrinsics
 
 template <class ColorT>
 int64_t integrate_any(TsdfVolume& volume, const DeviceImage<float>& depth, const DeviceImage<ColorT>& color,
-                      const Intrinsics& K, const Eigen::Isometry3f& T_wc, const ReflectionObservation* refl) {
+                      const Intrinsics& K, const Eigen::Isometry3f& T_wc, const ReflectionObservation* refl,
+                      const DeviceImage<float>* normal_depth) {
   if (!K.valid()) throw std::invalid_argument("integrate: invalid intrinsics " + K.to_string());
   const Device& dev = volume.device();
   check_image(depth, "depth", K, dev);
   check_image(color, "colour", K, dev);
+  if (normal_depth) check_image(*normal_depth, "normals' depth", K, dev);
   Buffer<int32_t> remap;
   if (refl) {
     if (!refl->plane_ids || !refl->reflection_mask)
@@ -41,7 +43,7 @@ int64_t integrate_any(TsdfVolume& volume, const DeviceImage<float>& depth, const
     remap = Buffer<int32_t>::from_host(refl->plane_remap, dev);
   }
   TsdfVolume::FrameScratch& scratch = volume.frame_scratch();
-  compute_vertex_normal_maps_into(scratch.maps, depth, K);
+  compute_vertex_normal_maps_into(scratch.maps, depth, normal_depth ? *normal_depth : depth, K);
   const VertexNormalMaps& maps = scratch.maps;
   const Eigen::Matrix3f R_wc = T_wc.linear();
   const Eigen::Vector3f t_wc = T_wc.translation();
@@ -68,13 +70,15 @@ int64_t integrate_any(TsdfVolume& volume, const DeviceImage<float>& depth, const
 }  // namespace
 
 int64_t integrate(TsdfVolume& volume, const DeviceImage<float>& depth, const DeviceImage<Color>& color,
-                  const Intrinsics& K, const Eigen::Isometry3f& T_wc, const ReflectionObservation* reflection) {
-  return integrate_any(volume, depth, color, K, T_wc, reflection);
+                  const Intrinsics& K, const Eigen::Isometry3f& T_wc, const ReflectionObservation* reflection,
+                  const DeviceImage<float>* normal_depth) {
+  return integrate_any(volume, depth, color, K, T_wc, reflection, normal_depth);
 }
 
 int64_t integrate(TsdfVolume& volume, const DeviceImage<float>& depth, const DeviceImage<Rgb8>& color,
-                  const Intrinsics& K, const Eigen::Isometry3f& T_wc, const ReflectionObservation* reflection) {
-  return integrate_any(volume, depth, color, K, T_wc, reflection);
+                  const Intrinsics& K, const Eigen::Isometry3f& T_wc, const ReflectionObservation* reflection,
+                  const DeviceImage<float>* normal_depth) {
+  return integrate_any(volume, depth, color, K, T_wc, reflection, normal_depth);
 }
 
 DeviceImage<int32_t> plane_ids_to_device(const LabelImage& labels, const Device& device) {

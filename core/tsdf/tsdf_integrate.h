@@ -24,14 +24,19 @@ struct ReflectionObservation {
 };
 
 // Fuses depth (metres, 0 = invalid) and colour (float RGB [0,1] or 8-bit) seen by a camera with
-// intrinsics K at pose T_wc. All images must be K's size and on the volume's device (throws
+// intrinsics K at pose T_wc. The point-to-plane sdf and the grazing test take their normals from
+// normal_depth when given (the tracker's bilateral-filtered D_k, Tracker::normal_depth(): noisy
+// depth at fine resolutions has noise for normals), from depth otherwise; the surface positions are
+// always depth's. All images must be K's size and on the volume's device (throws
 // std::invalid_argument naming the mismatch). Returns the number of blocks the frame touched.
 int64_t integrate(TsdfVolume& volume, const DeviceImage<float>& depth, const DeviceImage<Color>& color,
                   const Intrinsics& K, const Eigen::Isometry3f& T_wc,
-                  const ReflectionObservation* reflection = nullptr);
+                  const ReflectionObservation* reflection = nullptr,
+                  const DeviceImage<float>* normal_depth = nullptr);
 int64_t integrate(TsdfVolume& volume, const DeviceImage<float>& depth, const DeviceImage<Rgb8>& color,
                   const Intrinsics& K, const Eigen::Isometry3f& T_wc,
-                  const ReflectionObservation* reflection = nullptr);
+                  const ReflectionObservation* reflection = nullptr,
+                  const DeviceImage<float>* normal_depth = nullptr);
 
 // uint16 plane labels (LabelImage, as files store them) -> the int32 image integrate() takes.
 DeviceImage<int32_t> plane_ids_to_device(const LabelImage& labels, const Device& device);

@@ -62,6 +62,42 @@ TEST(DepthMaps, InvalidDepthInvalidatesItsNeighbours) {
   EXPECT_FALSE(N(22, 20).isZero());
 }
 
+// The sensor's positions with another depth's normals (the tracker's bilateral-filtered D_k): V is
+// depth's bit for bit, N is the normal depth's, and a pixel without depth has neither.
+TEST(DepthMaps, VerticesFromTheDepthNormalsFromTheNormalDepth) {
+  const Eigen::Vector3f n = Eigen::Vector3f(0.3f, -0.2f, 1.0f).normalized();
+  const DepthImage tilted = plane_depth(n, 1.5f);
+  DepthImage flat(kK.width, kK.height, 2.0f);
+  flat(30, 20) = 0.0f;
+  test::expect_device_parity<float>(
+      [&](const Device& device) {
+        const auto maps = compute_vertex_normal_maps(DeviceImage<float>::from_host(flat, device),
+                                                     DeviceImage<float>::from_host(tilted, device), kK);
+        const auto own = compute_vertex_normal_maps(DeviceImage<float>::from_host(flat, device), kK);
+        const auto V = maps.vertices.to_host(), N = maps.normals.to_host(), V_own = own.vertices.to_host();
+        for (int y = 1; y < kK.height - 1; ++y)
+          for (int x = 1; x < kK.width - 1; ++x) {
+            EXPECT_EQ(V(x, y), V_own(x, y)) << x << "," << y;
+            if (x == 30 && y == 20) {
+              EXPECT_TRUE(V(x, y).isZero());
+              EXPECT_TRUE(N(x, y).isZero());  // the normal depth has a normal here, the depth no point
+            } else {
+              EXPECT_LT((N(x, y) + n).norm(), 1e-4) << x << "," << y;
+            }
+          }
+        return flatten(maps);
+      },
+      1e-5, 1e-5);
+  const DepthImage small(10, 10, 1.0f);
+  try {
+    compute_vertex_normal_maps(DeviceImage<float>::from_host(flat, Device::cpu()),
+                               DeviceImage<float>::from_host(small, Device::cpu()), kK);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("normals' depth is 10x10"), std::string::npos) << e.what();
+  }
+}
+
 TEST(DepthMaps, SizeMismatchNamesBothSizes) {
   const DepthImage depth(10, 10, 1.0f);
   try {

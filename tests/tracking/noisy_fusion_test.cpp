@@ -2,10 +2,12 @@
 // that resolution Kinect-like noise (σ(z) = 1.2 mm + 1.9 mm (z − 0.4)², ≈ 1.4 cm at 3 m) is larger
 // than the pixel spacing (≈ 6 mm at 3 m), so normals from central differences of the *raw* depth
 // are noise. The TSDF's point-to-plane sdf and grazing-angle test then leave half the model empty
-// and ICP's inlier ratio falls under the failure threshold. Fusing the preprocessed (bilateral-
-// filtered) D_k, as `rrg track` now does (Tracker::preprocessed_depth), keeps the model whole.
-// Measured on this scene: raw fusion covers 56 % of the pixels and frame 1 is degraded (inlier ratio
-// 0.34); the preprocessed depth covers 95 % and frame 1 is ok (0.73), 0.15 mm / 0.006° off.
+// and ICP's inlier ratio falls under the failure threshold. Fusing with the normals of the
+// preprocessed (bilateral-filtered) D_k (Tracker::normal_depth), as `rrg track` and sessions do,
+// keeps the model whole. Measured on this scene: raw fusion covers 56 % of the pixels and frame 1 is
+// degraded (inlier ratio 0.34); the preprocessed depth covered 95 % and frame 1 was ok (0.73),
+// 0.15 mm / 0.006° off. The positions are the sensor's (docs/tracking.md "Positions from the
+// sensor, normals from the filter").
 #include "core/tracking/se3.h"
 #include "core/tracking/tracker.h"
 #include "core/tsdf/tsdf_integrate.h"
@@ -47,7 +49,7 @@ struct NoisyTwoFrames {
   }
 };
 
-TEST(NoisyFusion, TracksSecondFrameAt640x480WhenFusingPreprocessedDepth) {
+TEST(NoisyFusion, TracksSecondFrameAt640x480WhenFusingWithFilteredNormals) {
   const NoisyTwoFrames s;
   TsdfParams tsdf;  // rrg track's defaults: 1 cm voxels, truncation 4 voxels
   tsdf.voxel_size = 0.01f;
@@ -62,20 +64,25 @@ TEST(NoisyFusion, TracksSecondFrameAt640x480WhenFusingPreprocessedDepth) {
 
   const TrackResult r0 = tracker.track({0, &s.color, &s.d0, nullptr}, model, nullptr);
   ASSERT_TRUE(r0.first);
-  ASSERT_NE(tracker.preprocessed_depth(), nullptr);
-  integrate(volume, *tracker.preprocessed_depth(), DeviceImage<Color>::from_host(s.color, Device::cpu()), s.K, s.T0);
+  ASSERT_NE(tracker.normal_depth(), nullptr);
+  integrate(volume, DeviceImage<float>::from_host(s.d0, Device::cpu()),
+            DeviceImage<Color>::from_host(s.color, Device::cpu()), s.K, s.T0, nullptr, tracker.normal_depth());
   model.invalidate();
 
-  // The model seen from T0 covers (almost) every pixel that has depth.
+  // The model seen from T0 covers most pixels that have depth, and frame 1 tracks. Measured: with
+  // the filtered normals 81 % of the pixels, inlier ratio 0.455, 0.20 mm / 0.006° off; with the raw
+  // depth's own normals 60 %, 0.357, 0.54 mm / 0.012°. (Fusing the filtered depth itself covered 95 %
+  // at 0.73, but its positions drift with the view: ScaleDrift.) One frame of raw depth is a rough
+  // surface at this noise; later frames average it.
   const IcpModel m = model.model_at(s.T0);
   const auto normals = m.normals->to_host();
   size_t covered = 0;
   for (const auto& n : normals.pixels()) covered += n.squaredNorm() > 0.5f;
-  EXPECT_GT(double(covered), 0.9 * double(normals.pixels().size())) << covered << " model pixels";
+  EXPECT_GT(double(covered), 0.7 * double(normals.pixels().size())) << covered << " model pixels";
 
   const TrackResult r1 = tracker.track({1, &s.color, &s.d1, nullptr}, model, nullptr);
-  EXPECT_EQ(r1.state, TrackingState::Ok) << r1.note << " inlier ratio " << r1.icp.inlier_ratio;
-  EXPECT_GT(r1.icp.inlier_ratio, params.icp.ok_inlier_ratio);
+  EXPECT_NE(r1.state, TrackingState::Lost) << r1.note << " inlier ratio " << r1.icp.inlier_ratio;
+  EXPECT_GT(r1.icp.inlier_ratio, 0.4);
   EXPECT_LT(translation_distance(r1.T_wc.cast<double>(), s.T1.cast<double>()), 0.003);
   EXPECT_LT(rotation_distance(r1.T_wc.cast<double>(), s.T1.cast<double>()), 0.2 * kDeg);
 }

@@ -106,6 +106,52 @@ TEST(Preprocess, PyramidLevelsHaveHalvedIntrinsicsAndConsistentVertices) {
                std::invalid_argument);
 }
 
+// V_k^l are the sensor's, N_k^l the filter's (docs/tracking.md "Positions from the sensor, normals
+// from the filter"): level 0's depth is the input bit for bit, its filtered depth is the bilateral
+// filter's, and every level's maps are those of (depth, filtered); without the filter both come from
+// the depth.
+template <class T>
+std::vector<T> host_pixels(const DeviceImage<T>& image) {
+  const Image<T> host = image.to_host();
+  return {host.pixels().begin(), host.pixels().end()};
+}
+template <class T>
+std::vector<T> host_pixels(const Image<T>& image) {
+  return {image.pixels().begin(), image.pixels().end()};
+}
+
+TEST(Preprocess, PyramidPositionsAreTheSensorsAndNormalsTheFilters) {
+  const Intrinsics K = test::test_intrinsics(96, 72);
+  auto box = test::render_box(K, test::look_at({0, 0, 0}, {2, 1, 0.5f}));
+  for (int i = 0; i < int(box.depth.size()); i += 7) box.depth[size_t(i)] += 0.004f * float(i % 5) - 0.008f;
+  const auto raw = DeviceImage<float>::from_host(box.depth, Device::cpu());
+  const PreprocessParams p;
+  ASSERT_TRUE(p.bilateral);
+  const FramePyramid pyr = build_pyramid(raw, K, p);
+  EXPECT_EQ(host_pixels(pyr.levels[0].depth), host_pixels(box.depth));
+  const auto filtered = bilateral_filter_depth(raw, p.bilateral_radius, p.sigma_space_px, p.sigma_depth_m);
+  EXPECT_EQ(host_pixels(pyr.levels[0].filtered), host_pixels(filtered));
+  EXPECT_NE(host_pixels(filtered), host_pixels(box.depth));  // the noise is smoothed: the two differ
+  for (size_t l = 0; l < pyr.levels.size(); ++l) {
+    const PyramidLevel& level = pyr.levels[l];
+    if (l > 0) {
+      EXPECT_EQ(host_pixels(level.depth), host_pixels(downsample_depth(pyr.levels[l - 1].depth, p.sigma_depth_m)));
+      EXPECT_EQ(host_pixels(level.filtered),
+                host_pixels(downsample_depth(pyr.levels[l - 1].filtered, p.sigma_depth_m)));
+    }
+    const VertexNormalMaps own = compute_vertex_normal_maps(level.depth, level.K);
+    const VertexNormalMaps smooth = compute_vertex_normal_maps(level.filtered, level.K);
+    EXPECT_EQ(host_pixels(level.maps.vertices), host_pixels(own.vertices)) << "level " << l;
+    EXPECT_EQ(host_pixels(level.maps.normals), host_pixels(smooth.normals)) << "level " << l;
+  }
+  PreprocessParams off;
+  off.bilateral = false;
+  const FramePyramid plain = build_pyramid(raw, K, off);
+  EXPECT_EQ(plain.levels[0].filtered.width(), 0);
+  EXPECT_EQ(&plain.levels[0].normal_depth(), &plain.levels[0].depth);
+  EXPECT_EQ(host_pixels(plain.levels[0].maps.normals), host_pixels(compute_vertex_normal_maps(raw, K).normals));
+}
+
 std::vector<float> pyramid_depths(const Device& device) {
   const Intrinsics K = test::test_intrinsics(96, 72);
   auto box = test::render_box(K, test::look_at({0, 0, 0}, {2, 1, 0.5f}));
@@ -114,8 +160,10 @@ std::vector<float> pyramid_depths(const Device& device) {
   std::vector<float> out;
   for (const PyramidLevel& l : pyr.levels) {
     const auto depth = l.depth.to_host();
+    const auto filtered = l.filtered.to_host();
     const auto normals = l.maps.normals.to_host();
     for (float d : depth.pixels()) out.push_back(d);
+    for (float d : filtered.pixels()) out.push_back(d);
     for (const auto& n : normals.pixels()) out.push_back(n.x() + 2 * n.y() + 3 * n.z());
   }
   return out;

@@ -59,8 +59,9 @@ struct Rig {
     if (i == 0) tracker.set_initial_pose(f.T_wc_gt->cast<float>());
     const TrackResult r = tracker.track({i, &f.color, &depth, nullptr}, model, &masks);
     if (r.state != TrackingState::Lost) {
-      integrate(volume, *tracker.preprocessed_depth(),
-                DeviceImage<Color>::from_host(f.color, Device::cpu()), dataset->intrinsics(), r.T_wc);
+      integrate(volume, DeviceImage<float>::from_host(depth, Device::cpu()),
+                DeviceImage<Color>::from_host(f.color, Device::cpu()), dataset->intrinsics(), r.T_wc, nullptr,
+                tracker.normal_depth());
       model.invalidate();
     }
     return r;

@@ -202,6 +202,49 @@ TEST(TsdfFusion, FusionAndRaycastAgreeAcrossDevices) {
   }
 }
 
+// integrate(..., normal_depth): the surface is where depth puts it, and the sdf's normals and the
+// grazing test are normal_depth's (the tracker's filtered D_k). A fronto-parallel wall at 1.5 m with
+// normals from a wall 5 cm behind it raycasts at 1.5 m; with normals from nothing, nothing fuses.
+TEST(TsdfFusion, PositionsFromTheDepthNormalsFromTheNormalDepth) {
+  const DepthImage wall(kK.width, kK.height, 1.5f), behind(kK.width, kK.height, 1.55f),
+      none(kK.width, kK.height, 0.0f);
+  const ColorImage grey(kK.width, kK.height, Eigen::Vector3f(0.5f, 0.5f, 0.5f));
+  const Eigen::Isometry3f T = Eigen::Isometry3f::Identity();
+  for (const Device& device : available_devices()) {
+    SCOPED_TRACE(device.to_string());
+    const auto depth = DeviceImage<float>::from_host(wall, device);
+    const auto color = DeviceImage<Color>::from_host(grey, device);
+    TsdfVolume volume(params_1cm(), device);
+    const auto normal_depth = DeviceImage<float>::from_host(behind, device);
+    integrate(volume, depth, color, kK, T, nullptr, &normal_depth);
+    const DepthImage seen = raycast(volume, kK, T, {}, RaycastOutputs::geometry()).depth.to_host();
+    int hits = 0;
+    for (int y = 2; y < kK.height - 2; ++y)
+      for (int x = 2; x < kK.width - 2; ++x)
+        if (seen(x, y) > 0) {
+          ++hits;
+          ASSERT_NEAR(seen(x, y), 1.5f, 0.002f) << x << "," << y;
+        }
+    EXPECT_GT(hits, (kK.width - 4) * (kK.height - 4) * 9 / 10);
+
+    TsdfVolume blind(params_1cm(), device);
+    const auto no_normals = DeviceImage<float>::from_host(none, device);
+    integrate(blind, depth, color, kK, T, nullptr, &no_normals);
+    int observed = 0;
+    for (const BlockData& b : blind.read_all_blocks())
+      for (const Voxel& v : b.voxels) observed += v.weight > 0;
+    EXPECT_EQ(observed, 0);
+
+    const auto small = DeviceImage<float>::from_host(DepthImage(10, 10, 1.0f), device);
+    try {
+      integrate(volume, depth, color, kK, T, nullptr, &small);
+      FAIL() << "no throw";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("normals' depth is 10x10"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(TsdfFusion, RejectsMismatchedImages) {
   TsdfVolume volume(params_1cm(), Device::cpu());
   const auto depth = DeviceImage<float>::from_host(DepthImage(10, 10, 1.0f), Device::cpu());
