@@ -83,10 +83,11 @@ struct OrbParams {
   bool mask_warp = true;
   // s of the ICP prior Λ = s JᵀJ_icp / σ_icp² in the BA (0 = none). JᵀJ / σ² counts every pixel
   // pair as an independent measurement, but neighbouring residuals share the model's error: against
-  // ground truth ICP knows ~1/100 of what it claims (mean NEES / 6 = 53–185 on the three presets),
-  // while the BA's own Σ Ω JᵀJ is within 1.2–4x of what the features know. s = 0.01 is ICP's honest
-  // information next to the BA's (bench/consistency, docs/tracking.md "How much to trust ICP").
-  float icp_prior_scale = 0.01f;
+  // ground truth ICP knows less than it claims (mean NEES / 6 = 4–31 on the three presets since its
+  // positions are the sensor's; 53–185 before), while the BA's own Σ Ω JᵀJ is within 1.3–2.8x of
+  // what the features know. s = 0.1 is ICP's honest information next to the BA's, 1/k_icp between
+  // mirror_room's 0.03 and office's 0.26 (bench/consistency, docs/tracking.md "How much to trust ICP").
+  float icp_prior_scale = 0.1f;
   // Consistency gate: the BA correction Δ = log(T_ba T_icp⁻¹) must satisfy Δᵀ Λ Δ <= χ²₆(99 %)
   // = 16.81 with the same ICP information Λ = s JᵀJ_icp / σ_icp² as the prior (off when s = 0):
   // ORB may move the pose along directions the geometry leaves weak, not against what it fixes.
