@@ -16,11 +16,14 @@ RRG_HD inline Eigen::Vector3f vertex_at(ImageView<const float> depth, const Intr
   return K.unproject(float(x), float(y), z);
 }
 
-// N_k^l(u) from central differences of V: normalize((V(x+1)-V(x-1)) x (V(y+1)-V(y-1))), flipped
-// to face the camera; 0 on the border or next to an invalid vertex.
-RRG_HD inline Eigen::Vector3f normal_at(ImageView<const Eigen::Vector3f> V, int x, int y) {
-  if (x <= 0 || y <= 0 || x >= V.width - 1 || y >= V.height - 1) return Eigen::Vector3f::Zero();
-  const Eigen::Vector3f c = V(x, y), l = V(x - 1, y), r = V(x + 1, y), u = V(x, y - 1), d = V(x, y + 1);
+// N_k^l(u) from central differences of the vertices of `depth` (unprojected here, tap by tap):
+// normalize((V(x+1)-V(x-1)) x (V(y+1)-V(y-1))), flipped to face the camera; 0 on the border or next
+// to an invalid depth.
+RRG_HD inline Eigen::Vector3f normal_at(ImageView<const float> depth, const Intrinsics& K, int x, int y) {
+  if (x <= 0 || y <= 0 || x >= depth.width - 1 || y >= depth.height - 1) return Eigen::Vector3f::Zero();
+  const Eigen::Vector3f c = vertex_at(depth, K, x, y), l = vertex_at(depth, K, x - 1, y),
+                        r = vertex_at(depth, K, x + 1, y), u = vertex_at(depth, K, x, y - 1),
+                        d = vertex_at(depth, K, x, y + 1);
   if (c.z() <= 0.0f || l.z() <= 0.0f || r.z() <= 0.0f || u.z() <= 0.0f || d.z() <= 0.0f)
     return Eigen::Vector3f::Zero();
   Eigen::Vector3f n = (r - l).cross(d - u);

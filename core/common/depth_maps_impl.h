@@ -5,23 +5,16 @@
 
 namespace rrg::kernel {
 
-// N from the vertices of normal_depth; V from depth (when it is another image, its vertices then
-// replace normal_depth's, and N is cleared where depth has none).
+// V from depth, N from the vertices of normal_depth, in one pass; N is 0 where depth has no vertex.
 template <class Backend>
 void vertex_normal_maps(Backend backend, ImageView<const float> depth, ImageView<const float> normal_depth,
                         Intrinsics K, ImageView<Eigen::Vector3f> vertices, ImageView<Eigen::Vector3f> normals) {
   const int w = depth.width;
   parallel_for(backend, depth.size(), [=] RRG_HD(int64_t i) {
-    vertices[i] = vertex_at(normal_depth, K, int(i % w), int(i / w));
-  });
-  ImageView<const Eigen::Vector3f> V = vertices;
-  parallel_for(backend, depth.size(), [=] RRG_HD(int64_t i) {
-    normals[i] = normal_at(V, int(i % w), int(i / w));
-  });
-  if (depth.data == normal_depth.data) return;
-  parallel_for(backend, depth.size(), [=] RRG_HD(int64_t i) {
-    vertices[i] = vertex_at(depth, K, int(i % w), int(i / w));
-    if (!(vertices[i].z() > 0.0f)) normals[i] = Eigen::Vector3f::Zero();
+    const int x = int(i % w), y = int(i / w);
+    const Eigen::Vector3f v = vertex_at(depth, K, x, y);
+    vertices[i] = v;
+    normals[i] = v.z() > 0.0f ? normal_at(normal_depth, K, x, y) : Eigen::Vector3f::Zero();
   });
 }
 

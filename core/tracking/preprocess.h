@@ -11,6 +11,7 @@
 #include "core/common/depth_maps.h"
 #include "core/tracking/tracking_params.h"
 
+#include <optional>
 #include <vector>
 
 namespace rrg {
@@ -34,6 +35,11 @@ struct FramePyramid {
 DeviceImage<float> bilateral_filter_depth(const DeviceImage<float>& depth, int radius, float sigma_space_px,
                                           float sigma_depth_m);
 
+// Level 0's filtered depth of build_pyramid: the bilateral filter with params' window and sigmas,
+// or nullopt when params.bilateral is off. Fusion with given poses (no tracker ran) takes its
+// normals from it, as tracked fusion does (Tracker::normal_depth() says why).
+std::optional<DeviceImage<float>> filtered_depth(const DeviceImage<float>& depth, const PreprocessParams& params);
+
 // Half resolution: mean of the valid pixels of each 2x2 block within 3σ_d of its top-left pixel.
 DeviceImage<float> downsample_depth(const DeviceImage<float>& depth, float sigma_depth_m);
 
@@ -42,5 +48,9 @@ Intrinsics half_intrinsics(const Intrinsics& K, int width, int height);
 
 // The whole preprocessing. Throws std::invalid_argument when depth and K disagree in size.
 FramePyramid build_pyramid(const DeviceImage<float>& depth, const Intrinsics& K, const PreprocessParams& params);
+// The same into `pyramid`, keeping its images where size and device match: a tracker preprocesses
+// every frame into one pyramid, and fresh images cost more in page faults than the filter itself.
+void build_pyramid_into(FramePyramid& pyramid, const DeviceImage<float>& depth, const Intrinsics& K,
+                        const PreprocessParams& params);
 
 }  // namespace rrg

@@ -110,10 +110,13 @@ TrackResult Tracker::track(const TrackInput& in, ModelSource& model, MaskSource*
 
   // Preprocessing, also on the first frame: its filtered depth is what fusion should integrate.
   auto t0 = Clock::now();
-  std::optional<DeviceImage<float>> uploaded;
-  if (!in.depth_device || !(in.depth_device->device() == device_))
-    uploaded = DeviceImage<float>::from_host(*in.depth, device_);
-  pyramid_ = build_pyramid(uploaded ? *uploaded : *in.depth_device, K_, params_.preprocess);
+  const DeviceImage<float>* depth = in.depth_device;
+  if (!depth || !(depth->device() == device_)) {
+    upload_.ensure(in.depth->width(), in.depth->height(), device_);
+    upload_.buffer().copy_from_host(in.depth->pixels());
+    depth = &upload_;
+  }
+  build_pyramid_into(pyramid_, *depth, K_, params_.preprocess);
   const FramePyramid& pyramid = pyramid_;
   r.ms_preprocess = ms_since(t0);
 

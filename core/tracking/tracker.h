@@ -112,7 +112,8 @@ class Tracker {
   Eigen::Isometry3f velocity_ = Eigen::Isometry3f::Identity();  // T_{k−2}⁻¹ T_{k−1}
   TrackingState state_ = TrackingState::Ok;
   KeyframeSet keyframes_;
-  FramePyramid pyramid_;  // of the last frame
+  FramePyramid pyramid_;  // of the last frame, rebuilt in place by each track()
+  DeviceImage<float> upload_;  // the frame's depth on the device when the caller gives it on the host only
   int next_keyframe_id_ = 0;
 };
 

@@ -152,6 +152,47 @@ TEST(Preprocess, PyramidPositionsAreTheSensorsAndNormalsTheFilters) {
   EXPECT_EQ(host_pixels(plain.levels[0].maps.normals), host_pixels(compute_vertex_normal_maps(raw, K).normals));
 }
 
+// build_pyramid_into (the tracker's, one pyramid for every frame) gives what a fresh pyramid gives,
+// whatever the pyramid held before: another frame, another size, the filter on or off, more levels.
+void expect_same_pyramid(const FramePyramid& a, const FramePyramid& b) {
+  ASSERT_EQ(a.levels.size(), b.levels.size());
+  for (size_t l = 0; l < a.levels.size(); ++l) {
+    SCOPED_TRACE("level " + std::to_string(l));
+    const PyramidLevel &x = a.levels[l], &y = b.levels[l];
+    EXPECT_EQ(x.K.to_string(), y.K.to_string());
+    EXPECT_EQ(host_pixels(x.depth), host_pixels(y.depth));
+    EXPECT_EQ(x.filtered.width(), y.filtered.width());
+    EXPECT_EQ(host_pixels(x.filtered), host_pixels(y.filtered));
+    EXPECT_EQ(host_pixels(x.maps.vertices), host_pixels(y.maps.vertices));
+    EXPECT_EQ(host_pixels(x.maps.normals), host_pixels(y.maps.normals));
+  }
+}
+
+TEST(Preprocess, PyramidBuiltInPlaceEqualsAFreshOne) {
+  auto frame = [](int w, int h, float yaw) {
+    const Intrinsics K = test::test_intrinsics(w, h);
+    auto box = test::render_box(K, test::look_at({0, 0, 0}, {2, 1 + yaw, 0.5f}));
+    for (int i = 0; i < int(box.depth.size()); i += 7) box.depth[size_t(i)] += 0.004f * float(i % 5) - 0.008f;
+    return std::pair{K, DeviceImage<float>::from_host(box.depth, Device::cpu())};
+  };
+  PreprocessParams on, off, two;
+  off.bilateral = false;
+  two.levels = 2;
+  FramePyramid reused;
+  const auto [K0, d0] = frame(96, 72, 0.0f);
+  const auto [K1, d1] = frame(96, 72, 0.3f);
+  const auto [K2, d2] = frame(64, 48, 0.1f);
+  for (const auto& [K, d, p] : {std::tuple{&K0, &d0, &on}, {&K1, &d1, &on}, {&K1, &d1, &off}, {&K0, &d0, &on},
+                                {&K2, &d2, &two}, {&K0, &d0, &on}}) {
+    build_pyramid_into(reused, *d, *K, *p);
+    expect_same_pyramid(reused, build_pyramid(*d, *K, *p));
+  }
+  // A size mismatch is refused before anything is written.
+  const FramePyramid before = build_pyramid(d0, K0, on);
+  EXPECT_THROW(build_pyramid_into(reused, d2, K0, on), std::invalid_argument);
+  expect_same_pyramid(reused, before);
+}
+
 std::vector<float> pyramid_depths(const Device& device) {
   const Intrinsics K = test::test_intrinsics(96, 72);
   auto box = test::render_box(K, test::look_at({0, 0, 0}, {2, 1, 0.5f}));
