@@ -5,6 +5,7 @@
 #include "core/planes/exposure_gain.h"
 #include "core/planes/remote_segmenter.h"
 #include "core/planes/semantic_labels.h"
+#include "core/tracking/preprocess.h"
 #include "core/tsdf/raycast_warp.h"
 #include "core/tsdf/tsdf_integrate.h"
 
@@ -466,6 +467,13 @@ FrameReport Session::process(const SessionFrame& frame) {
   }
   if (D_k == &tracked) D_k = &frame.depth;  // the map takes the frame, filled below, not what tracking saw
 
+  // The depth fusion takes its normals from: the tracker's filtered D_k, or with given poses the
+  // same filter run here (at 640x480 the raw depth's normals are noise; Tracker::normal_depth()).
+  std::optional<DeviceImage<float>> given_normal_depth;
+  if (s.config.gt_poses) given_normal_depth = filtered_depth(depth, s.tracker.params().preprocess);
+  const DeviceImage<float>* frame_normal_depth =
+      s.config.gt_poses ? (given_normal_depth ? &*given_normal_depth : nullptr) : s.tracker.normal_depth();
+
   // The fill, between frames with masks: the surfaces earlier fills found (world regions) at the
   // tracked pose, for fusion and the mapper (tracking saw this frame as it came, less the pixels its
   // masks filled; ICP's association drops points behind the model's surface). On a frame with masks, a
@@ -512,7 +520,7 @@ FrameReport Session::process(const SessionFrame& frame) {
       fuse_depth = DeviceImage<float>::from_host(filled, s.config.device);
       // The filtered depth is of what tracking saw: pixels it left out and the fill did not write
       // have no normal there, so they are not fused (what the glass showed).
-      if (const DeviceImage<float>* f = s.config.gt_poses ? nullptr : s.tracker.normal_depth()) {
+      if (const DeviceImage<float>* f = frame_normal_depth) {
         DepthImage smooth = f->to_host();
         copy_filled_depth(filled, written, smooth);
         fuse_normal_depth = DeviceImage<float>::from_host(smooth, s.config.device);
@@ -538,11 +546,9 @@ FrameReport Session::process(const SessionFrame& frame) {
       // The sensor's D_k with the normals of the bilateral-filtered one: at fine resolutions the raw
       // depth's noise exceeds the pixel spacing and its normals (point-to-plane sdf, grazing test)
       // would drop the surface, while filtered positions differ from view to view (docs/tracking.md
-      // "Positions from the sensor, normals from the filter"); with given poses nothing was
-      // preprocessed and the depth's own normals are used.
+      // "Positions from the sensor, normals from the filter"); with the filter off, the depth's own.
       const DeviceImage<float>* normal_depth =
-          fuse_depth ? (fuse_normal_depth ? &*fuse_normal_depth : nullptr)
-                     : (s.config.gt_poses ? nullptr : s.tracker.normal_depth());
+          fuse_depth ? (fuse_normal_depth ? &*fuse_normal_depth : nullptr) : frame_normal_depth;
       integrate(s.volume, fuse_depth ? *fuse_depth : depth, color, s.K, report.T_wc, identify ? &obs : nullptr,
                 normal_depth);
     }
