@@ -164,6 +164,7 @@ void run_eval(const EvalOptions& o) {
   for (const auto& ob : r.observed)
     j["observed_variance"].push_back({{"id", ob.id}, {"name", ob.name}, {"points", ob.variance.points},
                                       {"fraction_above", ob.variance.fraction_above}, {"median", ob.variance.median},
+                                      {"mean", ob.variance.mean}, {"mean_rgb", ob.variance.mean_rgb},
                                       {"verifiable", ob.verifiable}});
   if (r.interrupted) j["interrupted"] = true;
   if (o.json) {
@@ -189,8 +190,9 @@ void run_eval(const EvalOptions& o) {
   std::printf("variance the input shows on reflective GT planes (identification frames, ground truth; "
               "verifiable: > %.3g of the points above %.3g):\n", e.params.area_threshold, e.params.variance_threshold);
   for (const auto& ob : r.observed)
-    std::printf("  %-24s GT %3d: %.3f of %lld points above, median %.4f%s\n", ob.name.c_str(), ob.id,
-                ob.variance.fraction_above, (long long)ob.variance.points, ob.variance.median,
+    std::printf("  %-24s GT %3d: %.3f of %lld points above, median %.4f, mean %.4f (RGB %.4f)%s\n",
+                ob.name.c_str(), ob.id, ob.variance.fraction_above, (long long)ob.variance.points, ob.variance.median,
+                ob.variance.mean, ob.variance.mean_rgb,
                 ob.verifiable ? "" : "  (not verifiable)");
   for (const auto& c : r.cues) {
     std::printf("semantics %-7s reflective planes: precision %.3f (%d/%d) recall %.3f (%d/%d), mask IoU %.3f\n",

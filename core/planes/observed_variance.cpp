@@ -1,6 +1,7 @@
 #include "core/planes/observed_variance.h"
 
 #include <algorithm>
+#include <numeric>
 #include <stdexcept>
 #include <string>
 
@@ -23,13 +24,12 @@ void ObservedVariance::add(const Eigen::Isometry3f& T_wc, const DepthImage& dept
   check(depth.width(), depth.height(), "depth");
   check(color.width(), color.height(), "colour image");
   check(planes.width(), planes.height(), "plane map");
-  View v{T_wc.inverse(), T_wc, depth, Image<float>(K_.width, K_.height, 0.0f), planes};
-  for (size_t i = 0; i < color.size(); ++i) v.intensity[i] = color[i].sum() / 3.0f;  // x = (r + g + b) / 3
-  views_.push_back(std::move(v));
+  views_.push_back(View{T_wc.inverse(), T_wc, depth, color, planes});
 }
 
 std::map<int, PlaneObservedVariance> ObservedVariance::stats(const std::set<int>& planes, float delta_v) const {
   std::map<int, std::vector<float>> variances;
+  std::map<int, double> rgb_sums;  // per plane, the sum over points of the mean of the channels' variances
   for (const View& src : views_)
     for (int y = 0; y < K_.height; y += stride_)
       for (int x = 0; x < K_.width; x += stride_) {
@@ -37,7 +37,8 @@ std::map<int, PlaneObservedVariance> ObservedVariance::stats(const std::set<int>
         const float z = src.depth(x, y);
         if (id == 0 || !planes.count(id) || !(z > 0)) continue;
         const Eigen::Vector3f X = src.T_wc * K_.unproject(float(x), float(y), z);
-        double mean = 0, m2 = 0;  // Welford over the point's observations
+        double mean = 0, m2 = 0;  // Welford over the point's observations of x = (r + g + b) / 3
+        Eigen::Vector3d mean_c = Eigen::Vector3d::Zero(), m2_c = Eigen::Vector3d::Zero();  // and of r, g, b
         int n = 0;
         for (const View& v : views_) {
           const Eigen::Vector3f p = v.T_cw * X;
@@ -47,18 +48,27 @@ std::map<int, PlaneObservedVariance> ObservedVariance::stats(const std::set<int>
           if (!(uf >= 0 && vf >= 0 && uf < float(K_.width) && vf < float(K_.height))) continue;
           const int u = int(uf), w = int(vf);
           if (v.planes(u, w) != id || !(std::abs(v.depth(u, w) - p.z()) <= tolerance_)) continue;
-          const double xi = v.intensity(u, w), delta = xi - mean;
+          const Eigen::Vector3d c = v.color(u, w).cast<double>();
+          const double xi = c.sum() / 3.0, delta = xi - mean;
           ++n;
           mean += delta / n;
           m2 += delta * (xi - mean);
+          const Eigen::Vector3d delta_c = c - mean_c;
+          mean_c += delta_c / n;
+          m2_c += delta_c.cwiseProduct(c - mean_c);
         }
-        if (n >= 2) variances[id].push_back(float(m2 / n));
+        if (n >= 2) {
+          variances[id].push_back(float(m2 / n));
+          rgb_sums[id] += m2_c.sum() / (3.0 * n);
+        }
       }
   std::map<int, PlaneObservedVariance> out;
   for (auto& [id, vs] : variances) {
     PlaneObservedVariance s;
     s.points = int64_t(vs.size());
     s.fraction_above = double(std::count_if(vs.begin(), vs.end(), [&](float x) { return x > delta_v; })) / double(vs.size());
+    s.mean = std::accumulate(vs.begin(), vs.end(), 0.0) / double(vs.size());
+    s.mean_rgb = rgb_sums[id] / double(vs.size());
     std::nth_element(vs.begin(), vs.begin() + std::ptrdiff_t(vs.size() / 2), vs.end());
     s.median = vs[vs.size() / 2];
     out[id] = s;

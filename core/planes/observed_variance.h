@@ -10,7 +10,9 @@
 //     that pixel shows the same plane at a depth within `depth_tolerance` of the point's (not
 //     occluded, not another surface);
 //   - per point with at least two observations, the population variance of x = (r + g + b) / 3
-//     (the supplement's Welford statistic, M_2 / n), and per plane the fraction of points above δ_v.
+//     (the supplement's Welford statistic, M_2 / n), and per plane the fraction of points above δ_v;
+//   - per plane the mean of the channels' variances, which bounds what modelling reflections can
+//     add in PSNR (docs/planes.md "What the input shows").
 // A plane is "verifiable" when that fraction exceeds δ_area.
 #include "core/common/camera.h"
 #include "core/common/image.h"
@@ -28,6 +30,10 @@ struct PlaneObservedVariance {
   int64_t points = 0;          // points with at least two observations
   double fraction_above = 0;   // of those, the share with variance > δ_v
   double median = 0;           // median variance
+  double mean = 0;             // mean variance of x
+  double mean_rgb = 0;         // mean over points and channels of each channel's variance: the least
+                               // mean squared error (as PSNR counts it) that one colour per point leaves
+                               // over its views, i.e. what a model of the view-dependence could remove
   bool verifiable(double delta_area) const { return points > 0 && fraction_above > delta_area; }
 };
 
@@ -46,7 +52,7 @@ class ObservedVariance {
     Eigen::Isometry3f T_cw;
     Eigen::Isometry3f T_wc;
     DepthImage depth;
-    Image<float> intensity;
+    ColorImage color;
     LabelImage planes;
   };
   Intrinsics K_;

@@ -51,13 +51,35 @@ TEST(ObservedVariance, ChangingIntensityIsAboveTheThresholdAndConstantIsNot) {
   EXPECT_GT(s.at(1).points, 100);
   EXPECT_DOUBLE_EQ(s.at(1).fraction_above, 1.0);
   EXPECT_NEAR(s.at(1).median, 0.06, 1e-5);
+  EXPECT_GT(s.at(1).mean, 0.0225 + 1e-4);  // the twice-seen edge points pull it under the median
+  EXPECT_LT(s.at(1).mean, 0.06 - 1e-4);
   EXPECT_TRUE(s.at(1).verifiable(0.05));
   EXPECT_GT(s.at(2).points, 100);
   EXPECT_DOUBLE_EQ(s.at(2).fraction_above, 0.0);
   EXPECT_NEAR(s.at(2).median, 0.0, 1e-9);
+  EXPECT_NEAR(s.at(2).mean, 0.0, 1e-9);
   EXPECT_FALSE(s.at(2).verifiable(0.05));
   // Only the planes asked for.
   EXPECT_EQ(ov.stats({2}, 0.01f).count(1), 0u);
+}
+
+// The paper's statistic averages the channels first, so a change of hue at constant intensity is no
+// variance of x; PSNR counts it in every channel, and mean_rgb keeps it: views (0.2, 0.5, 0.8) and
+// (0.8, 0.5, 0.2) give r and b a variance of 0.09 each and g none, 0.06 on average. Grey walls have
+// mean_rgb = mean.
+TEST(ObservedVariance, AHueChangeIsNoVarianceOfXButCountsInEveryChannel) {
+  ObservedVariance ov(camera(), 0.05f, 2);
+  for (const auto& [tx, c] : {std::pair{0.0f, Color(0.2f, 0.5f, 0.8f)}, {0.05f, Color(0.8f, 0.5f, 0.2f)}}) {
+    WallView v = wall_view(tx, 0.5f);
+    for (size_t i = 0; i < v.color.size(); ++i)
+      if (v.planes[i] == 1) v.color[i] = c;
+    ov.add(v.T_wc, v.depth, v.color, v.planes);
+  }
+  const auto s = ov.stats({1, 2}, 0.01f);
+  EXPECT_NEAR(s.at(1).mean, 0.0, 1e-9);
+  EXPECT_DOUBLE_EQ(s.at(1).fraction_above, 0.0);
+  EXPECT_NEAR(s.at(1).mean_rgb, 0.06, 1e-6);
+  EXPECT_NEAR(s.at(2).mean_rgb, 0.0, 1e-9);
 }
 
 TEST(ObservedVariance, AnOccluderInFrontOfThePlaneIsNotAnObservationOfIt) {
@@ -71,6 +93,8 @@ TEST(ObservedVariance, AnOccluderInFrontOfThePlaneIsNotAnObservationOfIt) {
   const auto s = ov.stats({1}, 0.01f);
   ASSERT_EQ(s.count(1), 1u);
   EXPECT_NEAR(s.at(1).median, 0.0225, 1e-5);
+  EXPECT_NEAR(s.at(1).mean, 0.0225, 1e-5);  // every point is seen twice
+  EXPECT_NEAR(s.at(1).mean_rgb, 0.0225, 1e-5);  // grey: the same in every channel
   EXPECT_DOUBLE_EQ(s.at(1).fraction_above, 1.0);
   // With δ_v above 0.0225 nothing is above it.
   EXPECT_DOUBLE_EQ(ov.stats({1}, 0.03f).at(1).fraction_above, 0.0);
