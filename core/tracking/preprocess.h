@@ -49,7 +49,7 @@ Intrinsics half_intrinsics(const Intrinsics& K, int width, int height);
 // The whole preprocessing. Throws std::invalid_argument when depth and K disagree in size.
 FramePyramid build_pyramid(const DeviceImage<float>& depth, const Intrinsics& K, const PreprocessParams& params);
 // The same into `pyramid`, keeping its images where size and device match: a tracker preprocesses
-// every frame into one pyramid, and fresh images cost more in page faults than the filter itself.
+// every frame into one pyramid, and on the CUDA back end each fresh image is a cudaMalloc/cudaFree.
 void build_pyramid_into(FramePyramid& pyramid, const DeviceImage<float>& depth, const Intrinsics& K,
                         const PreprocessParams& params);
 

@@ -108,7 +108,7 @@ TrackResult Tracker::track(const TrackInput& in, ModelSource& model, MaskSource*
     return *orb;
   };
 
-  // Preprocessing, also on the first frame: its filtered depth is what fusion should integrate.
+  // Preprocessing, also on the first frame: its filtered depth gives fusion its normals.
   auto t0 = Clock::now();
   const DeviceImage<float>* depth = in.depth_device;
   if (!depth || !(depth->device() == device_)) {
