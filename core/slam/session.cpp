@@ -469,10 +469,10 @@ FrameReport Session::process(const SessionFrame& frame) {
 
   // The depth fusion takes its normals from: the tracker's filtered D_k, or with given poses the
   // same filter run here (at 640x480 the raw depth's normals are noise; Tracker::normal_depth()).
-  std::optional<DeviceImage<float>> given_normal_depth;
-  if (s.config.gt_poses) given_normal_depth = filtered_depth(depth, s.tracker.params().preprocess);
   const DeviceImage<float>* frame_normal_depth =
-      s.config.gt_poses ? (given_normal_depth ? &*given_normal_depth : nullptr) : s.tracker.normal_depth();
+      !s.config.gt_poses ? s.tracker.normal_depth()
+      : filter_depth_into(s.given_normal_depth, depth, s.tracker.params().preprocess) ? &s.given_normal_depth
+                                                                                        : nullptr;
 
   // The fill, between frames with masks: the surfaces earlier fills found (world regions) at the
   // tracked pose, for fusion and the mapper (tracking saw this frame as it came, less the pixels its

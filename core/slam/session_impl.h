@@ -102,6 +102,7 @@ struct Session::Impl {
   std::unique_ptr<MaskSource> masks;  // icp+orb+mask: rendered C_r
   DeviceImage<int32_t> mask_plane_ids;  // I at the ICP pose for the mask (render_reflection)
   Buffer<uint64_t> mask_zbuffer;        // its warp's scratch
+  DeviceImage<float> given_normal_depth;  // with given poses: the filtered D_k fusion's normals come from
   MappingWorker worker;
 
   // the schedule

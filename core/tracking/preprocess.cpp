@@ -34,9 +34,13 @@ DeviceImage<float> bilateral_filter_depth(const DeviceImage<float>& depth, int r
   return out;
 }
 
-std::optional<DeviceImage<float>> filtered_depth(const DeviceImage<float>& depth, const PreprocessParams& params) {
-  if (!params.bilateral) return std::nullopt;
-  return bilateral_filter_depth(depth, params.bilateral_radius, params.sigma_space_px, params.sigma_depth_m);
+bool filter_depth_into(DeviceImage<float>& out, const DeviceImage<float>& depth, const PreprocessParams& params) {
+  if (!params.bilateral) {
+    out = DeviceImage<float>();
+    return false;
+  }
+  bilateral_into(out, depth, params.bilateral_radius, params.sigma_space_px, params.sigma_depth_m);
+  return true;
 }
 
 DeviceImage<float> downsample_depth(const DeviceImage<float>& depth, float sigma_depth_m) {
@@ -63,10 +67,7 @@ void build_pyramid_into(FramePyramid& pyramid, const DeviceImage<float>& depth, 
   l0.depth.ensure(depth.width(), depth.height(), depth.device());
   mem::copy(l0.depth.buffer().data(), l0.depth.device(), depth.buffer().data(), depth.device(),
             depth.buffer().size() * sizeof(float));
-  if (params.bilateral)
-    bilateral_into(l0.filtered, depth, params.bilateral_radius, params.sigma_space_px, params.sigma_depth_m);
-  else
-    l0.filtered = DeviceImage<float>();
+  filter_depth_into(l0.filtered, depth, params);
   for (size_t l = 1; l < pyramid.levels.size(); ++l) {
     const PyramidLevel& prev = pyramid.levels[l - 1];
     PyramidLevel& level = pyramid.levels[l];

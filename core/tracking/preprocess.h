@@ -11,7 +11,6 @@
 #include "core/common/depth_maps.h"
 #include "core/tracking/tracking_params.h"
 
-#include <optional>
 #include <vector>
 
 namespace rrg {
@@ -35,10 +34,11 @@ struct FramePyramid {
 DeviceImage<float> bilateral_filter_depth(const DeviceImage<float>& depth, int radius, float sigma_space_px,
                                           float sigma_depth_m);
 
-// Level 0's filtered depth of build_pyramid: the bilateral filter with params' window and sigmas,
-// or nullopt when params.bilateral is off. Fusion with given poses (no tracker ran) takes its
-// normals from it, as tracked fusion does (Tracker::normal_depth() says why).
-std::optional<DeviceImage<float>> filtered_depth(const DeviceImage<float>& depth, const PreprocessParams& params);
+// Level 0's filtered depth of build_pyramid into `out` (its image kept where size and device
+// match): the bilateral filter with params' window and sigmas. Returns false, leaving `out` empty,
+// when params.bilateral is off. Fusion with given poses (no tracker ran) takes its normals from it,
+// as tracked fusion does (Tracker::normal_depth() says why).
+bool filter_depth_into(DeviceImage<float>& out, const DeviceImage<float>& depth, const PreprocessParams& params);
 
 // Half resolution: mean of the valid pixels of each 2x2 block within 3σ_d of its top-left pixel.
 DeviceImage<float> downsample_depth(const DeviceImage<float>& depth, float sigma_depth_m);

@@ -58,9 +58,10 @@ TEST(GivenPosesFusion, NormalsComeFromTheFilteredDepthAsWhenTracked) {
   auto direct_mesh = [&](const TsdfParams& params, bool filtered) {
     TsdfVolume volume(params, Device::cpu());
     const auto depth = DeviceImage<float>::from_host(f.depth, Device::cpu());
-    const auto normal_depth = filtered ? filtered_depth(depth, PreprocessParams{}) : std::nullopt;
+    DeviceImage<float> normal_depth;
+    if (filtered) EXPECT_TRUE(filter_depth_into(normal_depth, depth, PreprocessParams{}));
     integrate(volume, depth, DeviceImage<Color>::from_host(f.color, Device::cpu()), dataset->intrinsics(), T_wc,
-              nullptr, normal_depth ? &*normal_depth : nullptr);
+              nullptr, filtered ? &normal_depth : nullptr);
     return extract_mesh(volume);
   };
 
