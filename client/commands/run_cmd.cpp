@@ -64,17 +64,23 @@ std::vector<PlaneDelta> reflective_plane_deltas(const ImageScores& with, const I
 void print_timings(const RunTimings& t, const std::string& device) {
   const OptimiseTimes& o = t.mapping_optimise;
   std::printf("timing (%s, ms/frame): load %.2f (ahead; waited %.2f) | raycast %.2f preprocess %.2f icp %.2f"
-              " orb %.2f (mask %.2f) fuse %.2f identify %.2f = pre-mapping %.2f | mapping %.2f ms/step (raycast %.1f"
+              " orb %.2f (mask %.2f) fuse %.2f (stream %.2f) identify %.2f = pre-mapping %.2f | mapping %.2f ms/step (raycast %.1f"
               " densify %.1f optimise %.1f [render %.1f loss %.1f backward %.1f adam %.1f] prune %.1f) x %lld steps"
               " (%lld iterations; %s, %lld waited for the one before; %.2f ms/frame waited or inline) | wall %.2f ms/frame (%.2f FPS%s)\n",
               device.c_str(), t.load_ms, t.load_wait_ms, t.mean.raycast, t.mean.preprocess, t.mean.icp, t.mean.orb,
-              t.mean.mask, t.mean.fuse, t.mean.identify, t.premapping_ms, t.mapping_step_ms, t.mapping_raycast_ms,
+              t.mean.mask, t.mean.fuse, t.mean.stream, t.mean.identify, t.premapping_ms, t.mapping_step_ms, t.mapping_raycast_ms,
               t.mapping_densify_ms, t.mapping_optimise_ms, o.render, o.loss, o.backward, o.adam, t.mapping_prune_ms,
               (long long)t.mapping_steps, (long long)t.mapping_iterations, t.schedule.c_str(), (long long)t.mapping_waits, t.mean.mapping, t.wall_ms_per_frame,
               t.wall_ms_per_frame > 0 ? 1000.0 / t.wall_ms_per_frame : 0.0,
               t.rate_hz > 0 ? fmt::format("; input at most {:g} Hz, latency mean {:.1f} max {:.1f} ms", t.rate_hz,
                                            t.latency_mean_ms, t.latency_max_ms).c_str()
                             : "");
+}
+
+void print_tsdf(const RunMetrics& m) {
+  std::printf("tsdf: %lld blocks, %lld resident at the end; device %.1f MB (the pool: the most it held), host %.1f MB\n",
+              (long long)m.tsdf_blocks, (long long)m.tsdf_resident_blocks, double(m.tsdf_device_bytes) / 1e6,
+              double(m.tsdf_host_bytes) / 1e6);
 }
 
 void run(const RunCliOptions& o) {
@@ -105,6 +111,7 @@ void run(const RunCliOptions& o) {
   std::vector<std::pair<std::string, RunResult>> runs;
   runs.emplace_back(c.mapping.reflections ? "reflections" : "no-reflections", run_dataset(ro));
   print_timings(runs.back().second.timings, c.device.to_string());
+  print_tsdf(runs.back().second.metrics);
   const bool interrupted = runs.back().second.metrics.interrupted;
   if (interrupted && o.ablate) spdlog::warn("run: interrupted, so the --no-reflections run of the ablation is skipped");
   if (o.ablate && c.mapping.reflections && !interrupted) {

@@ -266,12 +266,12 @@ RunResult run_dataset(const RunOptions& o) {
   t.latency_mean_ms /= double(std::max<size_t>(n, 1));
   for (const FrameReport& r : reports) {
     t.mean.raycast += r.times.raycast, t.mean.preprocess += r.times.preprocess, t.mean.icp += r.times.icp;
-    t.mean.orb += r.times.orb, t.mean.mask += r.times.mask, t.mean.fuse += r.times.fuse;
+    t.mean.orb += r.times.orb, t.mean.mask += r.times.mask, t.mean.fuse += r.times.fuse, t.mean.stream += r.times.stream;
     t.mean.identify += r.times.identify;
     t.mean.mapping += r.times.mapping, t.mean.total += r.times.total;
   }
   const double per = 1.0 / double(reports.size());
-  for (double* v : {&t.mean.raycast, &t.mean.preprocess, &t.mean.icp, &t.mean.orb, &t.mean.mask, &t.mean.fuse,
+  for (double* v : {&t.mean.raycast, &t.mean.preprocess, &t.mean.icp, &t.mean.orb, &t.mean.mask, &t.mean.fuse, &t.mean.stream,
                     &t.mean.identify, &t.mean.mapping, &t.mean.total})
     *v *= per;
   t.premapping_ms = t.mean.raycast + t.mean.preprocess + t.mean.icp + t.mean.orb + t.mean.fuse + t.mean.identify;
@@ -298,6 +298,10 @@ RunResult run_dataset(const RunOptions& o) {
   m.base_gaussians = st.mapping.base_gaussians;
   m.reflection_gaussians = st.mapping.reflection_gaussians;
   m.reflective_planes = int64_t(st.reflective_planes.size());
+  m.tsdf_blocks = st.tsdf_blocks;
+  m.tsdf_resident_blocks = st.resident_blocks;
+  m.tsdf_device_bytes = st.tsdf_device_bytes;
+  m.tsdf_host_bytes = st.host_bytes;
   for (const FrameReport& r : reports) {
     m.filled_frames += r.filled_pixels > 0;
     m.filled_pixels += r.filled_pixels;
@@ -415,6 +419,10 @@ std::string metrics_json(const RunMetrics& m) {
   j["reflection_gaussians"] = m.reflection_gaussians;
   j["reflective_planes"] = m.reflective_planes;
   j["reflective_fill"] = {{"frames", m.filled_frames}, {"pixels", m.filled_pixels}};
+  j["tsdf"] = {{"blocks", m.tsdf_blocks},
+               {"resident_blocks", m.tsdf_resident_blocks},
+               {"device_mb", double(m.tsdf_device_bytes) / 1e6},
+               {"host_mb", double(m.tsdf_host_bytes) / 1e6}};
   return j.dump(2) + "\n";
 }
 
@@ -430,6 +438,7 @@ std::string timings_json(const RunTimings& t, const std::string& device) {
   j["orb"] = t.mean.orb;
   j["orb_mask"] = t.mean.mask;  // part of orb
   j["fuse"] = t.mean.fuse;
+  j["fuse_stream"] = t.mean.stream;  // part of fuse (tsdf.stream_radius)
   j["identify"] = t.mean.identify;
   j["premapping"] = t.premapping_ms;
   j["mapping_wait_or_inline"] = t.mean.mapping;

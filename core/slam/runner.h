@@ -77,6 +77,10 @@ struct RunMetrics {
   int64_t base_gaussians = 0, reflection_gaussians = 0, reflective_planes = 0;
   // Depth filled on reflective masks (planes.fill): frames with a fill, and pixels in all.
   int64_t filled_frames = 0, filled_pixels = 0;
+  // The TSDF at the end: blocks in all and resident on the device (fewer with tsdf.stream_radius),
+  // the device bytes (the pool's capacity: the most it held) and the host bytes of streamed-out blocks.
+  int64_t tsdf_blocks = 0, tsdf_resident_blocks = 0;
+  size_t tsdf_device_bytes = 0, tsdf_host_bytes = 0;
 };
 
 struct RunTimings {

@@ -104,7 +104,13 @@ Session::Impl::Impl(SessionConfig c, std::unique_ptr<SemanticCue> cue)
     : config(validated(std::move(c))),
       K(config.K),
       volume(config.tsdf_params(), config.device),
-      model(volume, K, volume_mutex),
+      model(volume, K,
+            [this](const Eigen::Isometry3f& T_wc, const std::function<void()>& read) {
+              read_view(K, T_wc, [&] {
+                read();
+                return 0;
+              });
+            }),
       tracker(config.tracking_params(), K, config.device),
       identifier(config.planes, cue ? std::move(cue) : cue_from_config(config)),
       mapper(config.mapping, K, config.device) {
@@ -139,8 +145,7 @@ const SessionConfig& Session::config() const { return impl_->config; }
 RaycastResult Session::Impl::locked_raycast(const Intrinsics& K_, const Eigen::Isometry3f& T_wc,
                                             RaycastOutputs outputs) const {
   const std::vector<int32_t> ids = remap_copy();
-  std::shared_lock lock(volume_mutex);
-  return raycast(volume, K_, T_wc, ids, outputs);
+  return read_view(K_, T_wc, [&] { return raycast(volume, K_, T_wc, ids, outputs); });
 }
 
 // C_r at the ICP pose for the tracking mask (§4.1.2): pass 3 over the plane-id map only, each
@@ -230,8 +235,9 @@ MappingContext Session::Impl::mapping_context() {
   // keep the table taken here whichever thread runs them: a live step prepares on the mapping
   // thread, after identifications that may have merged planes since.
   ctx.raycast = [this, ids = std::move(ids)](const Intrinsics& K_, const Eigen::Isometry3f& T_wc) {
-    std::shared_lock lock(volume_mutex);
-    return raycast(volume, K_, T_wc, ids, RaycastOutputs{.color = true, .reflection = true, .normals = false});
+    return read_view(K_, T_wc, [&] {
+      return raycast(volume, K_, T_wc, ids, RaycastOutputs{.color = true, .reflection = true, .normals = false});
+    });
   };
   return ctx;
 }
@@ -551,6 +557,13 @@ FrameReport Session::process(const SessionFrame& frame) {
           fuse_depth ? (fuse_normal_depth ? &*fuse_normal_depth : nullptr) : frame_normal_depth;
       integrate(s.volume, fuse_depth ? *fuse_depth : depth, color, s.K, report.T_wc, identify ? &obs : nullptr,
                 normal_depth);
+      // tsdf.stream_radius: the blocks far from the camera to host memory (fusion brings back
+      // those a later frame touches, read_view those a view needs).
+      if (s.config.stream_radius > 0.0f) {
+        const auto ts = Clock::now();
+        s.volume.stream_out(report.T_wc.translation(), s.config.stream_radius);
+        report.times.stream = ms_since(ts);
+      }
     }
     s.model.invalidate();
     report.times.fuse = ms_since(tf);

@@ -11,7 +11,9 @@
 //                      live = true pre-mapping never waits for a running step (mapping_schedule.h).
 // process() is called by one thread (the session's worker); every const query below may be called
 // from any thread at the same time (renders use the last published Gaussian snapshot and take the
-// volume lock only for the raycast).
+// volume lock only for the raycast). With tsdf.stream_radius > 0 the TSDF blocks far from the
+// camera live in host memory between frames; every query still sees the whole map (the blocks it
+// needs come back for it and go out again; docs/tsdf.md "Streaming in a session").
 #include "core/common/camera.h"
 #include "core/common/image.h"
 #include "core/common/mesh.h"
@@ -54,6 +56,7 @@ struct StageTimes {
   double orb = 0;          // ORB + motion-only BA (+ the tracking mask)
   double mask = 0;         // of orb: the tracking mask R_k^track (its plane-id map and pass 3)
   double fuse = 0;
+  double stream = 0;       // of fuse: streaming out the blocks far from the camera (tsdf.stream_radius)
   double identify = 0;     // plane identification incl. its C_var raycast, the cue's masks and the
                            // reflective depth fill (planes.fill; on frames that do not identify too)
   double mapping = 0;      // a mapping step run inline (sync) or waited for
@@ -110,12 +113,14 @@ struct SessionStatus {
   TrackingState state = TrackingState::Ok;
   Eigen::Isometry3f T_wc = Eigen::Isometry3f::Identity();  // last pose
   uint64_t map_version = 0;        // bumps on every fusion and mapping step
-  int64_t tsdf_blocks = 0;
+  int64_t tsdf_blocks = 0;         // resident and streamed out (tsdf.stream_radius)
+  int64_t resident_blocks = 0;     // of which on the volume's device
   int64_t keyframes = 0;
   int64_t global_planes = 0;
   std::vector<int> reflective_planes;  // accepted (L_ref), canonical ids
   MappingSummary mapping;
   size_t device_bytes = 0, host_bytes = 0;
+  size_t tsdf_device_bytes = 0;    // of device_bytes: the TSDF's (the rest estimates the Gaussians')
 };
 
 class Session {
@@ -141,9 +146,9 @@ class Session {
   // Thread-safe queries.
   SessionView render(const Intrinsics& K, const Eigen::Isometry3f& T_wc) const;
   TriangleMesh mesh(uint64_t changed_since = 0) const;   // marching cubes (of blocks changed since)
-  // Chunked mesh streaming (the HTTP viewer): the resident TSDF blocks fused into after volume
-  // version `since` (0 = all) with the volume version they are current to, read under one lock;
-  // and marching cubes of just the given resident blocks (welded among themselves).
+  // Chunked mesh streaming (the HTTP viewer): the TSDF blocks (resident or streamed out) fused into
+  // after volume version `since` (0 = all) with the volume version they are current to, read under
+  // one lock; and marching cubes of just the given blocks (welded among themselves).
   struct ChangedBlocks {
     std::vector<Eigen::Vector3i> blocks;
     uint64_t volume_version = 0;

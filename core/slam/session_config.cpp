@@ -164,6 +164,9 @@ void SessionConfig::validate() const {
   tracking_params().validate();
   planes.validate();
   mapping.validate();
+  if (!(stream_radius >= 0.0f && std::isfinite(stream_radius)))
+    throw std::invalid_argument("config tsdf.stream_radius: must be >= 0 metres (0: no streaming), got " +
+                                float_text(stream_radius));
   if (plane_period < 1) throw std::invalid_argument("config plane_period: must be >= 1");
   if (mapping_period < 1) throw std::invalid_argument("config mapping_period: must be >= 1");
   if (final_steps < 0) throw std::invalid_argument("config final_steps: must be >= 0");
@@ -216,6 +219,8 @@ std::vector<ConfigField> config_fields(SessionConfig& c) {
   t.f("tsdf.min_depth", c.tsdf.min_depth, "ignore depth below, metres");
   t.f("tsdf.max_depth", c.tsdf.max_depth, "ignore depth beyond, metres");
   t.i64("tsdf.initial_blocks", c.tsdf.initial_blocks, "initial hash / pool size, blocks");
+  t.f("tsdf.stream_radius", c.stream_radius,
+      "after each frame, TSDF blocks farther than this from the camera go to host memory, metres; 0: never");
   // tracking (§4.1.2)
   t.custom("tracking.mode", "icp | icp+orb | icp+orb+mask", [&c] { return to_string(c.tracking.mode); },
            [&c](const std::string& v) { c.tracking.mode = parse_tracking_mode(trim(v)); });

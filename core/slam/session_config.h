@@ -23,6 +23,8 @@ struct SessionConfig {
   Intrinsics K;                        // camera (width, height, fx, fy, cx, cy); required
   Device device;                       // CPU unless chosen
   TsdfParams tsdf;
+  float stream_radius = 0.0f;          // tsdf.stream_radius: TSDF blocks farther from the camera go to
+                                       // host memory after each frame, metres; 0 = never (docs/tsdf.md)
   TrackingParams tracking;
   IdentificationParams planes;
   MapperParams mapping;

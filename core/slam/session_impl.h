@@ -6,7 +6,10 @@
 //   volume_mutex   the TSDF, a readers-writer lock: fusion (process thread) writes and holds it
 //                  alone; raycasts (tracking, identification, the mapping thread's frames, renders
 //                  from any thread), meshes, status and saves only read it and share it, so the
-//                  mapping thread's raycasts run beside the process thread's;
+//                  mapping thread's raycasts run beside the process thread's. With streaming
+//                  (tsdf.stream_radius) fusion also streams out the blocks far from the camera, and
+//                  a reader that needs streamed-out blocks takes the lock alone to bring them back
+//                  and send them out again (read_view, read_blocks);
 //   state_mutex    trajectory, reports, status fields, reflective planes.
 // The mapper publishes immutable snapshots for renders (core/slam/mapper.h), so rendering never
 // waits for a mapping step.
@@ -17,24 +20,30 @@
 #include "core/tracking/model_source.h"
 #include "core/tsdf/tsdf_raycast.h"
 #include "core/tsdf/tsdf_volume.h"
+#include "core/tsdf/view_frustum.h"
 
 #include <atomic>
 #include <set>
 #include <span>
 #include <condition_variable>
+#include <functional>
 #include <mutex>
 #include <shared_mutex>
 #include <thread>
 
 namespace rrg {
 
-// ICP's model source with the raycast taken under the volume lock.
+// ICP's model source with the raycast taken under the volume lock, with the blocks it sees resident.
 class LockedModelSource final : public ModelSource {
  public:
-  LockedModelSource(const TsdfVolume& volume, const Intrinsics& K, std::shared_mutex& m) : inner_(volume, K), mutex_(m) {}
+  // locked(T_wc, read) runs read() under the volume lock with the view of (K, T_wc) resident.
+  using Locked = std::function<void(const Eigen::Isometry3f&, const std::function<void()>&)>;
+  LockedModelSource(const TsdfVolume& volume, const Intrinsics& K, Locked locked)
+      : inner_(volume, K), locked_(std::move(locked)) {}
   IcpModel model_at(const Eigen::Isometry3f& T_wc) override {
-    std::shared_lock lock(mutex_);  // the cached maps of inner_ are the process thread's alone
-    return inner_.model_at(T_wc);
+    IcpModel m;  // the cached maps of inner_ are the process thread's alone
+    locked_(T_wc, [&] { m = inner_.model_at(T_wc); });
+    return m;
   }
   void invalidate() { inner_.invalidate(); }
   // The process thread's alone, as the cached maps (TsdfModelSource).
@@ -43,7 +52,7 @@ class LockedModelSource final : public ModelSource {
 
  private:
   TsdfModelSource inner_;
-  std::shared_mutex& mutex_;
+  Locked locked_;
 };
 
 // The mapping thread: runs one step at a time when asked; wait() blocks until it is idle.
@@ -82,6 +91,45 @@ struct Session::Impl {
   MappingContext mapping_context();
   RaycastResult locked_raycast(const Intrinsics& K, const Eigen::Isometry3f& T_wc,
                                RaycastOutputs outputs = RaycastOutputs::all()) const;
+  // Streaming (tsdf.stream_radius; docs/tsdf.md "Streaming in a session"). Runs read() under the
+  // volume lock with every block a camera K at T_wc may read resident (ViewFrustum). The lock is
+  // shared when they are (always without streaming); else it is taken alone, the streamed-out
+  // ones come back for read() and go out again after it, so a read leaves the volume's residency
+  // as it found it. Should read() throw, they stay until the next frame streams out.
+  template <class Read>
+  auto read_view(const Intrinsics& K_view, const Eigen::Isometry3f& T_wc, Read&& read) const {
+    const ViewFrustum frustum(K_view, T_wc, volume.params());
+    return read_with(read, [&](const Eigen::Vector3i& b) { return frustum.may_read(b); });
+  }
+  // The same for meshing the listed blocks: they and the blocks whose voxels their cubes read
+  // (the +x, +y, +z neighbours) resident.
+  template <class Read>
+  auto read_blocks(std::span<const Eigen::Vector3i> blocks, Read&& read) const {
+    std::vector<uint64_t> needed;
+    needed.reserve(blocks.size() * 8);
+    for (const Eigen::Vector3i& b : blocks)
+      for (int d = 0; d < 8; ++d) {
+        const Eigen::Vector3i n = b + Eigen::Vector3i(d & 1, (d >> 1) & 1, (d >> 2) & 1);
+        needed.push_back(block_key(n.x(), n.y(), n.z()));
+      }
+    std::sort(needed.begin(), needed.end());
+    return read_with(read, [&](const Eigen::Vector3i& b) {
+      return std::binary_search(needed.begin(), needed.end(), block_key(b.x(), b.y(), b.z()));
+    });
+  }
+  template <class Read, class Needs>
+  auto read_with(Read& read, const Needs& needs) const {
+    {
+      std::shared_lock lock(volume_mutex);
+      if (volume.num_host_blocks() == 0 || volume.host_blocks_where(needs).empty()) return read();
+    }
+    std::unique_lock lock(volume_mutex);
+    const std::vector<Eigen::Vector3i> back = volume.host_blocks_where(needs);
+    volume.stream_in(back);
+    auto result = read();
+    volume.stream_out(back);
+    return result;
+  }
   // C_r for the tracking mask, exact where its mean RGB stays <= stop_mean (the mask's threshold)
   ReflectionView render_reflection(const Eigen::Isometry3f& T_wc, float stop_mean);
   std::vector<int32_t> unmodelled_planes(const MapSnapshot* snap) const;
@@ -94,7 +142,9 @@ struct Session::Impl {
   SessionConfig config;
   Intrinsics K;
   mutable std::shared_mutex volume_mutex;
-  TsdfVolume volume;
+  // mutable: a reader may bring streamed-out blocks back for its read and send them out again
+  // (read_view): where the blocks are held changes, never what they hold.
+  mutable TsdfVolume volume;
   LockedModelSource model;
   Tracker tracker;
   PlaneIdentifier identifier;

@@ -2,6 +2,7 @@
 #include "core/slam/session_impl.h"
 #include "core/tsdf/tsdf_mesh.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace rrg {
@@ -29,10 +30,22 @@ SessionView Session::render(const Intrinsics& K, const Eigen::Isometry3f& T_wc) 
 TriangleMesh Session::mesh(uint64_t changed_since) const {
   const Impl& s = *impl_;
   const std::vector<int32_t> remap = s.remap_copy();
-  std::shared_lock lock(s.volume_mutex);
-  if (changed_since == 0) return extract_mesh(s.volume, remap);
-  const auto blocks = s.volume.changed_blocks(changed_since);
-  return extract_mesh(s.volume, blocks, remap);
+  if (changed_since == 0) {
+    {
+      std::shared_lock lock(s.volume_mutex);
+      if (s.volume.num_host_blocks() == 0) return extract_mesh(s.volume, remap);
+    }
+    // Streamed out (tsdf.stream_radius): meshed slab by slab with no more blocks resident than
+    // now, the same mesh as with every block resident; the resident ones stay so.
+    std::unique_lock lock(s.volume_mutex);
+    return extract_mesh_streamed(s.volume, std::max<int64_t>(s.volume.num_blocks(), 1), remap);
+  }
+  std::vector<Eigen::Vector3i> blocks;
+  {
+    std::shared_lock lock(s.volume_mutex);
+    blocks = s.volume.changed_blocks(changed_since);
+  }
+  return mesh_of_blocks(blocks);
 }
 
 Session::ChangedBlocks Session::changed_blocks(uint64_t since) const {
@@ -44,8 +57,7 @@ Session::ChangedBlocks Session::changed_blocks(uint64_t since) const {
 TriangleMesh Session::mesh_of_blocks(const std::vector<Eigen::Vector3i>& blocks) const {
   const Impl& s = *impl_;
   const std::vector<int32_t> remap = s.remap_copy();
-  std::shared_lock lock(s.volume_mutex);
-  return extract_mesh(s.volume, blocks, remap);
+  return s.read_blocks(blocks, [&] { return extract_mesh(s.volume, blocks, remap); });
 }
 
 GaussianHost Session::base_gaussians() const { return impl_->mapper.base_host(); }
@@ -72,8 +84,10 @@ SessionStatus Session::status() const {
   {
     std::shared_lock lock(s.volume_mutex);
     st.tsdf_blocks = s.volume.num_blocks() + s.volume.num_host_blocks();
+    st.resident_blocks = s.volume.num_blocks();
     const MemoryUsage m = s.volume.memory();
     st.device_bytes = m.device_bytes;
+    st.tsdf_device_bytes = m.device_bytes;
     st.host_bytes = m.host_bytes;
   }
   std::lock_guard lock(s.state_mutex);

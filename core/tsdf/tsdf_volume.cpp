@@ -95,6 +95,11 @@ std::vector<Eigen::Vector3i> TsdfVolume::changed_blocks(uint64_t since) const {
   std::vector<Eigen::Vector3i> out;
   for (size_t i = 0; i < keys.size(); ++i)
     if (versions[i] > since) out.push_back(block_coord(keys[i]));
+  std::vector<uint64_t> host;
+  for (const auto& [key, block] : host_blocks_)
+    if (block.version > since) host.push_back(key);
+  std::sort(host.begin(), host.end());
+  for (uint64_t k : host) out.push_back(block_coord(k));
   return out;
 }
 
@@ -341,6 +346,17 @@ int64_t TsdfVolume::stream_in(const Eigen::Vector3f& center, float radius) {
   for (const auto& [key, block] : host_blocks_)
     if ((block_center(block.coord, params_.voxel_size) - center).norm() <= radius) back.push_back(&block);
   return stream_in_blocks(std::move(back));
+}
+
+std::vector<Eigen::Vector3i> TsdfVolume::host_blocks_where(const std::function<bool(const Eigen::Vector3i&)>& keep) const {
+  std::vector<uint64_t> keys;
+  for (const auto& [key, block] : host_blocks_)
+    if (keep(block.coord)) keys.push_back(key);
+  std::sort(keys.begin(), keys.end());
+  std::vector<Eigen::Vector3i> out;
+  out.reserve(keys.size());
+  for (uint64_t k : keys) out.push_back(block_coord(k));
+  return out;
 }
 
 int64_t TsdfVolume::stream_in(std::span<const Eigen::Vector3i> blocks) {

@@ -22,6 +22,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <unordered_map>
@@ -58,8 +59,9 @@ class TsdfVolume {
 
   // Resident block coordinates in pool order.
   std::vector<Eigen::Vector3i> block_coords() const;
-  // Resident blocks fused into after version `since` (0 = every block ever fused), for streaming
-  // changed mesh blocks.
+  // Blocks fused into after version `since` (0 = every block ever fused), resident first (pool
+  // order), then streamed out (sorted): for streaming changed mesh blocks, which meshing sees only
+  // once they are resident again.
   std::vector<Eigen::Vector3i> changed_blocks(uint64_t since) const;
   // One block, resident or streamed out; nullopt when never allocated.
   std::optional<BlockData> read_block(const Eigen::Vector3i& coord) const;
@@ -78,6 +80,8 @@ class TsdfVolume {
   int64_t stream_in(std::span<const Eigen::Vector3i> blocks);
   // Coordinates of the streamed-out blocks, sorted (x, then y, then z).
   std::vector<Eigen::Vector3i> host_block_coords() const;
+  // The streamed-out blocks for which keep(coord) holds, sorted (x, then y, then z).
+  std::vector<Eigen::Vector3i> host_blocks_where(const std::function<bool(const Eigen::Vector3i&)>& keep) const;
 
   // --- used by the algorithms (tsdf_integrate.cpp, tsdf_raycast.cpp, ...) -----------------------
   kernel::HashView hash_view() { return {hash_keys_.span(), hash_values_.span()}; }

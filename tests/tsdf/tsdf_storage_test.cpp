@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <set>
 #include <tuple>
@@ -243,6 +244,33 @@ TEST(TsdfStorage, ChangedBlocksAreThoseFusedSinceAVersion) {
   EXPECT_GT(part.triangles.size(), 0u);
   EXPECT_LT(part.triangles.size(), whole.triangles.size());
   for (const auto& p : part.vertices) ASSERT_GT(p.x(), -0.05f);  // the side the second camera saw
+
+  // Streamed out, a changed block is still listed (after the resident ones), with its version.
+  const Eigen::Vector3f far_side(-1.0f, 0.0f, 0.0f);  // only blocks on the +x side go out
+  const auto all = [](const Eigen::Vector3i&) { return true; };
+  EXPECT_TRUE(v.host_blocks_where(all).empty());
+  const int64_t out = v.stream_out(far_side, 1.0f);
+  ASSERT_GT(out, 0);
+  ASSERT_GT(v.num_blocks(), 0);
+  EXPECT_EQ(v.host_blocks_where(all), v.host_block_coords());
+  EXPECT_EQ(int64_t(v.host_blocks_where(all).size()), out);
+  const auto upper = v.host_blocks_where([](const Eigen::Vector3i& c) { return c.y() >= 0; });
+  EXPECT_GT(upper.size(), 0u);
+  EXPECT_LT(int64_t(upper.size()), out);
+  for (const auto& c : upper) EXPECT_GE(c.y(), 0);
+  auto sorted = [](std::vector<Eigen::Vector3i> c) {
+    std::sort(c.begin(), c.end(), [](const Eigen::Vector3i& a, const Eigen::Vector3i& b) {
+      return std::tie(a.x(), a.y(), a.z()) < std::tie(b.x(), b.y(), b.z());
+    });
+    return c;
+  };
+  EXPECT_EQ(sorted(v.changed_blocks(v1)), sorted(changed));
+  EXPECT_EQ(v.changed_blocks(0).size(), size_t(v.num_blocks() + v.num_host_blocks()));
+  EXPECT_TRUE(v.changed_blocks(v.version()).empty());
+  const auto listed = v.changed_blocks(0);
+  const auto host = v.host_block_coords();
+  EXPECT_TRUE(std::equal(host.begin(), host.end(), listed.end() - std::ptrdiff_t(host.size())))
+      << "the streamed-out blocks come last, sorted";
 }
 
 }  // namespace
