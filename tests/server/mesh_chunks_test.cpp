@@ -32,6 +32,9 @@ class MeshChunksSession : public ::testing::Test {
                                  (dir_.path() / "seq").string());
     ASSERT_EQ(r.exit_code, 0) << r.output;
     dataset_ = io::open_dataset(dir_.path() / "seq");
+    session_ = std::make_unique<Session>(config());
+  }
+  SessionConfig config() const {
     SessionConfig c;
     c.K = dataset_->intrinsics();
     c.tsdf.voxel_size = 0.02f;  // a coarse map keeps the CPU test fast
@@ -40,10 +43,11 @@ class MeshChunksSession : public ::testing::Test {
     c.gt_poses = true;
     c.sync = true;
     c.mapping.iterations = 2;
-    session_ = std::make_unique<Session>(c);
+    return c;
   }
   // patch_only: depth only in a 12x12-pixel window at the centre, so the frame fuses a small region.
-  void process(size_t i, bool patch_only = false) {
+  void process(size_t i, bool patch_only = false) { process(*session_, i, patch_only); }
+  void process(Session& session, size_t i, bool patch_only = false) {
     io::Frame f = dataset_->load(i);
     const Eigen::Isometry3f T_wc = f.T_wc_gt->cast<float>();
     SessionFrame s = to_session_frame(std::move(f));
@@ -52,7 +56,7 @@ class MeshChunksSession : public ::testing::Test {
         for (int x = 0; x < s.depth.width(); ++x)
           if (std::abs(x - s.depth.width() / 2) > 6 || std::abs(y - s.depth.height() / 2) > 6) s.depth(x, y) = 0;
     s.pose = T_wc;
-    session_->process(s);
+    session.process(s);
   }
   // key -> (etag, Draco bytes) of every chunk
   static std::map<std::string, std::pair<std::string, std::vector<uint8_t>>> all(MeshChunks& chunks, const Session& s) {
@@ -108,6 +112,32 @@ TEST_F(MeshChunksSession, ChunksAreTheWholeMeshAndUnchangedEtagsMeanUnchangedMes
   EXPECT_GT(changed, 0u);  // the new frame fused somewhere
   EXPECT_GT(kept, 0u);     // ... but not everywhere
   std::printf("[mesh chunks] %zu chunks: %zu kept their ETag, %zu changed or new\n", later.size(), kept, changed);
+}
+
+// A session that streams its TSDF (tsdf.stream_radius) serves the same chunks, ETags and bytes,
+// as one that holds every block, after the first frames and after one more: the chunks of blocks
+// in host memory are listed and meshed too, and reading them leaves them there.
+TEST_F(MeshChunksSession, AStreamedSessionServesTheSameChunks) {
+  SessionConfig c = config();
+  c.stream_radius = 0.5f;  // less than the distance to any wall: nearly every block goes out
+  Session streamed(c);
+  MeshChunks held_chunks, streamed_chunks;
+  for (size_t i = 0; i < 8; ++i) {
+    process(i, i == 7);
+    process(streamed, i, i == 7);
+    if (i != 5 && i != 7) continue;
+    const SessionStatus st = streamed.status();
+    ASSERT_LT(st.resident_blocks, st.tsdf_blocks / 2) << "too little was streamed out to test anything";
+    const auto a = all(held_chunks, *session_), b = all(streamed_chunks, streamed);
+    ASSERT_GT(a.size(), 1u);
+    ASSERT_EQ(a.size(), b.size());
+    for (const auto& [key, chunk] : a) {
+      ASSERT_TRUE(b.count(key)) << key;
+      EXPECT_EQ(b.at(key).first, chunk.first) << key;
+      EXPECT_EQ(b.at(key).second, chunk.second) << "chunk " << key << " meshed differently";
+    }
+    EXPECT_EQ(streamed.status().resident_blocks, st.resident_blocks) << "serving chunks left blocks resident";
+  }
 }
 
 }  // namespace
