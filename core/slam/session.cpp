@@ -122,6 +122,12 @@ Session::Impl::Impl(SessionConfig c, std::unique_ptr<SemanticCue> cue)
 
 Session::Session(SessionConfig config, std::unique_ptr<SemanticCue> cue)
     : impl_(std::make_unique<Impl>(std::move(config), std::move(cue))) {
+  if (const float r = impl_->config.stream_radius, reach = view_reach(impl_->K, impl_->config.tsdf_params());
+      r > 0.0f && r < reach)
+    spdlog::warn("session: tsdf.stream_radius {:.2f} m is less than the {:.2f} m a frame reaches (tsdf.max_depth {:.2f} m "
+                 "along the image corners): blocks in view go to host memory and back every frame; {:.2f} m or more "
+                 "avoids that",
+                 r, reach, impl_->config.tsdf.max_depth, reach);
   spdlog::debug("session: {}x{} on {}, tracking {}, semantics {}, mapping every {} frames ({})", impl_->K.width,
                 impl_->K.height, impl_->config.device.to_string(), to_string(impl_->config.tracking.mode),
                 impl_->identifier.cue().name(), impl_->config.mapping_period, to_string(impl_->config.schedule()));
