@@ -1,6 +1,7 @@
 // ViewFrustum: the blocks a raycast may read. Known answers on an axis-aligned camera, and the
 // property streaming relies on: a raycast with only the frustum's blocks resident is the raycast
 // of the whole volume, bit for bit.
+#include "core/common/device.h"
 #include "core/tsdf/tsdf_raycast.h"
 #include "core/tsdf/view_frustum.h"
 #include "tests/tsdf/analytic_scene.h"
@@ -76,40 +77,43 @@ TEST(ViewFrustum, ARaycastWithOnlyItsBlocksResidentIsTheWholeVolumesRaycast) {
     const float a = float(k) * float(M_PI) / 4.0f;
     poses.push_back(test::look_at(Eigen::Vector3f::Zero(), Eigen::Vector3f(std::cos(a), 0.1f, std::sin(a))));
   }
-  TsdfVolume whole(p, Device::cpu()), part(p, Device::cpu());
-  test::fuse_scene(whole, scene, kK, poses);
-  test::fuse_scene(part, scene, kK, poses);
-  ASSERT_GT(whole.num_blocks(), 300);
-  // The views: the fusion's, moved and tilted ones, and a wider, coarser camera.
-  std::vector<std::pair<Intrinsics, Eigen::Isometry3f>> views;
-  for (const auto& T : poses) views.emplace_back(kK, T);
-  views.emplace_back(kK, test::look_at({0.3f, -0.2f, 0.1f}, {1.5f, 0.3f, 0.4f}));
-  views.emplace_back(kK, test::look_at({-0.4f, 0.1f, 0.2f}, {-1.0f, 0.0f, -1.6f}));
-  views.emplace_back(Intrinsics{30.0f, 30.0f, 39.5f, 29.5f, 80, 60}, test::look_at({0, 0, 0}, {0.2f, 0.0f, 1.0f}));
-  int64_t left_out = 0;
-  for (const auto& [K, T] : views) {
-    part.stream_in_all();
-    const ViewFrustum f(K, T, p);
-    std::vector<Eigen::Vector3i> out;
-    for (const Eigen::Vector3i& b : part.block_coords())
-      if (!f.may_read(b)) out.push_back(b);
-    part.stream_out(out);
-    left_out += int64_t(out.size());
-    const RaycastResult a = raycast(whole, K, T), b = raycast(part, K, T);
-    const Image<float> depth = a.depth.to_host();
-    int hits = 0;
-    for (float d : depth.pixels()) hits += d > 0 ? 1 : 0;
-    EXPECT_GT(hits, 100);
-    EXPECT_TRUE(same(a.depth, b.depth));
-    EXPECT_TRUE(same(a.vertices, b.vertices));
-    EXPECT_TRUE(same(a.normals, b.normals));
-    EXPECT_TRUE(same(a.colors, b.colors));
-    EXPECT_TRUE(same(a.plane_ids, b.plane_ids));
-    EXPECT_TRUE(same(a.reflection, b.reflection));
-    EXPECT_TRUE(same(a.color_variance, b.color_variance));
+  for (const Device& device : available_devices()) {
+    SCOPED_TRACE(device.to_string());
+    TsdfVolume whole(p, device), part(p, device);
+    test::fuse_scene(whole, scene, kK, poses);
+    test::fuse_scene(part, scene, kK, poses);
+    ASSERT_GT(whole.num_blocks(), 300);
+    // The views: the fusion's, moved and tilted ones, and a wider, coarser camera.
+    std::vector<std::pair<Intrinsics, Eigen::Isometry3f>> views;
+    for (const auto& T : poses) views.emplace_back(kK, T);
+    views.emplace_back(kK, test::look_at({0.3f, -0.2f, 0.1f}, {1.5f, 0.3f, 0.4f}));
+    views.emplace_back(kK, test::look_at({-0.4f, 0.1f, 0.2f}, {-1.0f, 0.0f, -1.6f}));
+    views.emplace_back(Intrinsics{30.0f, 30.0f, 39.5f, 29.5f, 80, 60}, test::look_at({0, 0, 0}, {0.2f, 0.0f, 1.0f}));
+    int64_t left_out = 0;
+    for (const auto& [K, T] : views) {
+      part.stream_in_all();
+      const ViewFrustum f(K, T, p);
+      std::vector<Eigen::Vector3i> out;
+      for (const Eigen::Vector3i& b : part.block_coords())
+        if (!f.may_read(b)) out.push_back(b);
+      part.stream_out(out);
+      left_out += int64_t(out.size());
+      const RaycastResult a = raycast(whole, K, T), b = raycast(part, K, T);
+      const Image<float> depth = a.depth.to_host();
+      int hits = 0;
+      for (float d : depth.pixels()) hits += d > 0 ? 1 : 0;
+      EXPECT_GT(hits, 100);
+      EXPECT_TRUE(same(a.depth, b.depth));
+      EXPECT_TRUE(same(a.vertices, b.vertices));
+      EXPECT_TRUE(same(a.normals, b.normals));
+      EXPECT_TRUE(same(a.colors, b.colors));
+      EXPECT_TRUE(same(a.plane_ids, b.plane_ids));
+      EXPECT_TRUE(same(a.reflection, b.reflection));
+      EXPECT_TRUE(same(a.color_variance, b.color_variance));
+    }
+    // The frustum is not the whole volume: most views leave out most blocks.
+    EXPECT_GT(left_out, int64_t(views.size()) * whole.num_blocks() / 3);
   }
-  // The frustum is not the whole volume: most views leave out most blocks.
-  EXPECT_GT(left_out, int64_t(views.size()) * whole.num_blocks() / 3);
 }
 
 }  // namespace
