@@ -110,6 +110,12 @@ class DeviceImage {
     d.buffer_.copy_from_host(image.pixels());
     return d;
   }
+  // from_host into this image, keeping its buffer when it has the size and device already (a loop
+  // that uploads a frame every frame allocates only for the first).
+  void upload(const Image<T>& image, const Device& device) {
+    ensure(image.width(), image.height(), device);
+    buffer_.copy_from_host(image.pixels());
+  }
   Image<T> to_host() const {
     Image<T> out(width_, height_);
     mem::copy(out.data(), Device::cpu(), buffer_.data(), buffer_.device(), buffer_.size() * sizeof(T));

@@ -439,8 +439,10 @@ FrameReport Session::process(const SessionFrame& frame) {
     }
     report.times.identify += ms_since(tf);
   }
-  const auto depth = DeviceImage<float>::from_host(*D_k, s.config.device);
-  const auto color = DeviceImage<Color>::from_host(frame.color, s.config.device);
+  s.frame_depth.upload(*D_k, s.config.device);
+  s.frame_color.upload(frame.color, s.config.device);
+  const DeviceImage<float>& depth = s.frame_depth;
+  const DeviceImage<Color>& color = s.frame_color;
 
   // 1. tracking (§4.1.2), or the given pose. Mapping keyframes are the tracker's keyframes (the
   // first frame included); with given poses, every N_o-th fused frame.

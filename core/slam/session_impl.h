@@ -153,6 +153,8 @@ struct Session::Impl {
   DeviceImage<int32_t> mask_plane_ids;  // I at the ICP pose for the mask (render_reflection)
   Buffer<uint64_t> mask_zbuffer;        // its warp's scratch
   DeviceImage<float> given_normal_depth;  // with given poses: the filtered D_k fusion's normals come from
+  DeviceImage<float> frame_depth;         // this frame's D_k as tracked and fused, on the device (reused)
+  DeviceImage<Color> frame_color;         // and its colour
   MappingWorker worker;
 
   // the schedule

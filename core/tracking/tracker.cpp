@@ -112,8 +112,7 @@ TrackResult Tracker::track(const TrackInput& in, ModelSource& model, MaskSource*
   auto t0 = Clock::now();
   const DeviceImage<float>* depth = in.depth_device;
   if (!depth || !(depth->device() == device_)) {
-    upload_.ensure(in.depth->width(), in.depth->height(), device_);
-    upload_.buffer().copy_from_host(in.depth->pixels());
+    upload_.upload(*in.depth, device_);
     depth = &upload_;
   }
   build_pyramid_into(pyramid_, *depth, K_, params_.preprocess);

@@ -86,5 +86,27 @@ TEST(DeviceImage, RoundTripsOnEveryDevice) {
   }
 }
 
+TEST(DeviceImage, UploadKeepsItsBufferForTheSameSize) {
+  Image<uint16_t> a(7, 5), b(7, 5), c(4, 3);
+  for (size_t i = 0; i < a.size(); ++i) a[i] = uint16_t(i * 31), b[i] = uint16_t(1000 - i);
+  for (size_t i = 0; i < c.size(); ++i) c[i] = uint16_t(i + 7);
+  auto equal = [](const Image<uint16_t>& x, const Image<uint16_t>& y) {
+    return x.same_size(y) && std::equal(x.pixels().begin(), x.pixels().end(), y.pixels().begin());
+  };
+  for (const Device& device : available_devices()) {
+    SCOPED_TRACE(device.to_string());
+    DeviceImage<uint16_t> d;
+    d.upload(a, device);
+    EXPECT_TRUE(equal(d.to_host(), a));
+    const uint16_t* kept = d.buffer().data();
+    d.upload(b, device);  // same size: the same buffer, the new pixels
+    EXPECT_EQ(d.buffer().data(), kept);
+    EXPECT_TRUE(equal(d.to_host(), b));
+    d.upload(c, device);  // another size
+    EXPECT_EQ(d.width(), 4);
+    EXPECT_TRUE(equal(d.to_host(), c));
+  }
+}
+
 }  // namespace
 }  // namespace rrg
