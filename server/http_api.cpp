@@ -134,6 +134,7 @@ json info_json(const v1::SessionInfo& i) {
           {"pose", pose_json(i.pose())},
           {"map_version", i.map_version()},
           {"tsdf_blocks", i.tsdf_blocks()},
+          {"tsdf_resident_blocks", i.tsdf_resident_blocks()},
           {"base_gaussians", i.base_gaussians()},
           {"reflection_gaussians", i.reflection_gaussians()},
           {"reflective_planes", std::vector<int>(i.reflective_planes().begin(), i.reflective_planes().end())},

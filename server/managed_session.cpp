@@ -235,6 +235,7 @@ v1::SessionInfo ManagedSession::info() const {
   *i.mutable_pose() = service::to_proto(st.T_wc);
   i.set_map_version(st.map_version);
   i.set_tsdf_blocks(uint64_t(st.tsdf_blocks));
+  i.set_tsdf_resident_blocks(uint64_t(st.resident_blocks));
   i.set_keyframes(uint64_t(st.keyframes));
   i.set_global_planes(uint64_t(st.global_planes));
   for (int p : st.reflective_planes) i.add_reflective_planes(p);

@@ -169,6 +169,29 @@ TEST(Service, FourSessionsStreamAtOnceEachCorrect) {
   for (const auto& h : hs) c.close(h);
 }
 
+// A session created with tsdf.stream_radius keeps most of its TSDF in host memory and still
+// gives the in-process (non-streaming) session's poses, block count and mesh.
+TEST(Service, AStreamingSessionGivesTheSameMapWithFewerBlocksResident) {
+  auto c = shared_server().client();
+  auto req = create_request();
+  (*req.mutable_config())["tsdf.stream_radius"] = "0.5";
+  const auto r = c.create(req);
+  const SessionHandle h{r.session_id(), r.token()};
+  const auto results = stream_frames(c, h, 0, wire_frames().size());
+  expect_reference_trajectory(results);
+  const Session& ref = reference_session();
+  const v1::SessionInfo info = c.get(h);
+  EXPECT_EQ(info.tsdf_blocks(), uint64_t(ref.status().tsdf_blocks));
+  EXPECT_LT(info.tsdf_resident_blocks(), info.tsdf_blocks() / 2);
+  EXPECT_GT(info.host_bytes(), 0u);
+  const service::Blob mesh = c.mesh(h);
+  const TriangleMesh ref_mesh = ref.mesh();
+  EXPECT_EQ(mesh.triangles, ref_mesh.triangles.size());
+  EXPECT_EQ(mesh.count, ref_mesh.vertices.size());
+  EXPECT_EQ(c.get(h).tsdf_resident_blocks(), info.tsdf_resident_blocks()) << "the mesh left blocks resident";
+  c.close(h);
+}
+
 TEST(Service, MeshAndGaussiansDecodeToTheSessionsCounts) {
   auto c = shared_server().client();
   const SessionHandle h = create(c);
