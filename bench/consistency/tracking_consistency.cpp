@@ -73,6 +73,9 @@ int main(int argc, char** argv) {
   app.add_option("--voxel", voxel, "TSDF voxel size, metres");
   app.add_option("--max-depth", max_depth, "ignore depth beyond, metres");
   app.add_option("--max-frames", max_frames, "stop after N frames (0 = all)");
+  float model_sigma = 0.0f;
+  app.add_option("--model-sigma", model_sigma, "σ_m of ICP's model term, metres (IcpParams::model_sigma_m)")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--skip", skip, "track every N-th frame (larger motion per frame)")->check(CLI::PositiveNumber);
   app.add_flag("--synth-masks", synth_masks,
                "keep ORB off the generator's ground-truth reflection masks (reflection/), as icp+orb+mask does");
@@ -88,6 +91,7 @@ int main(int argc, char** argv) {
     TrackingParams params;
     params.mode = TrackingMode::Icp;  // stage 2 is run here, from the ground-truth keyframes
     params.orb.max_depth_range = orb_depth_range;
+    params.icp.model_sigma_m = model_sigma;
     TsdfParams tsdf;
     tsdf.voxel_size = voxel;
     tsdf.truncation = 4.0f * voxel;

@@ -236,6 +236,8 @@ std::vector<ConfigField> config_fields(SessionConfig& c) {
       "ICP Huber threshold, metres (on residuals scaled to the reference depth's noise)");
   t.b("tracking.icp.noise_weighting", c.tracking.icp.noise_weighting,
       "weigh ICP pairs by the sensor noise σ_n(z) (planes.segmentation.noise_*) at their depth");
+  t.f("tracking.icp.model_sigma_m", c.tracking.icp.model_sigma_m,
+      "σ_m of the model surface added in quadrature to σ_n(z) in ICP's noise weights, metres; 0: the sensor's alone");
   t.f("tracking.icp.noise_reference_depth_m", c.tracking.icp.noise_reference_depth_m,
       "depth where a pair's noise weight is 1 and Huber sees its residual unscaled, metres");
   t.i("tracking.orb.features", c.tracking.orb.features, "ORB features per frame");

@@ -45,6 +45,10 @@ kernel::IcpSystem reduce_icp_system(const VertexNormalMaps& source, const IcpMod
   if (params.noise_weighting) {
     args.noise = params.noise;
     args.sigma_ref = params.noise.sigma(params.noise_reference_depth_m);
+    if (params.model_sigma_m > 0.0f) {
+      args.model_variance = params.model_sigma_m * params.model_sigma_m;
+      args.sigma_ref = std::sqrt(args.sigma_ref * args.sigma_ref + args.model_variance);
+    }
   }
   kernel::IcpSystem s;
   RRG_DISPATCH(dev, s = kernel::reduce_icp_cpu(args), s = kernel::reduce_icp_cuda(args));

@@ -60,6 +60,8 @@ struct IcpArgs {
   // z, and σ_n at the reference depth; off when sigma_ref = 0.
   DepthNoiseModel noise;
   float sigma_ref = 0.0f;
+  // σ_m² of the model surface (IcpParams::model_sigma_m), added to σ_n(z)² (sigma_ref includes it)
+  float model_variance = 0.0f;
 };
 
 // Rounded single-precision multiply and add that the compiler may not fuse into an FMA. The
@@ -124,8 +126,11 @@ RRG_HD inline void icp_accumulate(const IcpArgs& a, int64_t i, IcpSystem& s) {
   if (d.squaredNorm() > a.max_distance * a.max_distance) return;
   if ((a.R_wc * n).dot(m) < a.min_cos) return;
   const float r = d.dot(m);
-  float scale = 1.0f;  // s = σ_ref / σ_n(z)
-  if (a.sigma_ref > 0.0f) scale = a.sigma_ref / a.noise.sigma(v.z());
+  float scale = 1.0f;  // s = σ_ref / σ_n(z), or with a model term σ_ref / sqrt(σ_n(z)² + σ_m²)
+  if (a.sigma_ref > 0.0f) {
+    const float sigma = a.noise.sigma(v.z());
+    scale = a.model_variance > 0.0f ? a.sigma_ref / sqrtf(sigma * sigma + a.model_variance) : a.sigma_ref / sigma;
+  }
   const float r_ref = r * scale;
   const float w = scale * scale * (fabsf(r_ref) <= a.huber_delta ? 1.0f : a.huber_delta / fabsf(r_ref));
   const Eigen::Vector3f pm = p.cross(m);

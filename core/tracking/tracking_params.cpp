@@ -1,5 +1,6 @@
 #include "core/tracking/tracking_params.h"
 
+#include <cmath>
 #include <stdexcept>
 
 namespace rrg {
@@ -33,6 +34,7 @@ void TrackingParams::validate() const {
   if (icp.noise_weighting) {
     if (!icp.noise.valid()) fail("icp.noise must have a, b >= 0 and be finite");
     if (!(icp.noise_reference_depth_m > 0)) fail("icp.noise_reference_depth_m must be > 0");
+    if (!(icp.model_sigma_m >= 0 && std::isfinite(icp.model_sigma_m))) fail("icp.model_sigma_m must be >= 0 metres");
     // σ_n(z) >= a, its value at z0: a > 0 keeps every pair's weight finite.
     if (!(icp.noise.a > 0)) fail("icp.noise.a must be > 0 with noise weighting (σ_n(z) >= a divides the residuals)");
   }

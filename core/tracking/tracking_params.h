@@ -35,6 +35,10 @@ struct IcpParams {
   // planes.segmentation's).
   bool noise_weighting = true;
   float noise_reference_depth_m = 1.0f;
+  // σ_m, metres: the model surface's own error, added in quadrature to σ_n(z) in the weights,
+  // σ² = σ_n(z)² + σ_m² (0: the sensor's noise alone). Measured, not adopted: docs/tracking.md
+  // "A model term beside σ_n(z)".
+  float model_sigma_m = 0.0f;
   DepthNoiseModel noise;
   float min_inlier_ratio = 0.25f; // below: ICP failed (diverged or no overlap)
   float ok_inlier_ratio = 0.50f;  // below (and above min): tracking degraded

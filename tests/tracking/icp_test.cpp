@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <numbers>
 
 namespace rrg {
@@ -96,9 +98,10 @@ TEST(Icp, SystemAtTruePoseHasZeroResidualAndKnownCount) {
 // One pair by hand: a source point 3 m in front of the camera and its model point on a plane facing
 // it, r metres behind. With noise weighting the pair's weight is s² with s = σ_n(1 m) / σ_n(3 m)
 // = 0.001884 / 0.014044, and Huber sees r s instead of r.
-kernel::IcpSystem one_pair(float r, bool weighting) {
+kernel::IcpSystem one_pair(float r, bool weighting, float model_sigma = 0.0f) {
   IcpParams params;
   params.noise_weighting = weighting;
+  params.model_sigma_m = model_sigma;
   Image<Eigen::Vector3f> src_v(1, 1, Eigen::Vector3f(0, 0, 3)), src_n(1, 1, Eigen::Vector3f(0, 0, -1));
   Image<Eigen::Vector3f> mod_v(1, 1, Eigen::Vector3f(0, 0, 3 + r)), mod_n(1, 1, Eigen::Vector3f(0, 0, -1));
   const VertexNormalMaps source{DeviceImage<Eigen::Vector3f>::from_host(src_v, Device::cpu()),
@@ -137,6 +140,24 @@ TEST(Icp, NoiseWeightingScalesAPairByTheSensorNoiseAtItsDepth) {
   EXPECT_NEAR(one_pair(0.05f, false).jtj[11], 0.01 / 0.05, 1e-5);
 }
 
+// With a model term σ_m the pair's scale is s = sqrt(σ_n(1 m)² + σ_m²) / sqrt(σ_n(3 m)² + σ_m²):
+// 4 mm lifts the 3 m pair's weight from 0.018 to 0.12 of a 1 m pair's.
+TEST(Icp, AModelTermAddsToTheSensorNoiseInQuadrature) {
+  const DepthNoiseModel noise;
+  const double a = noise.sigma(1.0f), b = noise.sigma(3.0f), m = 0.004;
+  const double s = std::sqrt(a * a + m * m) / std::sqrt(b * b + m * m);
+  const kernel::IcpSystem on = one_pair(0.002f, true, 0.004f);
+  ASSERT_EQ(on.inliers, 1.0);
+  EXPECT_NEAR(on.jtj[11], s * s, 1e-6);
+  EXPECT_GT(s * s, 5.0 * (a / b) * (a / b));
+  EXPECT_NEAR(on.jtr[2], -s * s * 0.002, 1e-7);
+  EXPECT_NEAR(on.r2_ref, (0.002 * s) * (0.002 * s), 1e-10);
+  // 0 is the sensor's noise alone, bit for bit; without noise weighting the term does nothing.
+  const kernel::IcpSystem zero = one_pair(0.002f, true, 0.0f), plain = one_pair(0.002f, true);
+  EXPECT_EQ(zero.jtj[11], plain.jtj[11]);
+  EXPECT_EQ(one_pair(0.002f, false, 0.004f).jtj[11], one_pair(0.002f, false).jtj[11]);
+}
+
 TEST(Icp, RejectsModelOnAnotherDeviceOrWrongSize) {
   const Scene s;
   const DeviceModel model = upload_model(s.model, Device::cpu());
@@ -149,7 +170,7 @@ TEST(Icp, RejectsModelOnAnotherDeviceOrWrongSize) {
 
 // The reduced 6x6 system (21 + 6 + 4 numbers: JᵀJ, Jᵀr, r2, r2_ref, inliers, valid) at a perturbed
 // pose, on every device.
-std::vector<double> reduced_system(const Device& device) {
+std::vector<double> reduced_system(const Device& device, const IcpParams& params) {
   const Scene s;
   const DeviceModel model = upload_model(s.model, device);
   // Bilateral off: its expf rounds differently on the GPU, and a few ulps there flip the pyramid's
@@ -158,7 +179,7 @@ std::vector<double> reduced_system(const Device& device) {
   const FramePyramid pyr = build_pyramid(DeviceImage<float>::from_host(s.frame.depth, device), s.K, no_filter());
   std::vector<double> out;
   for (const PyramidLevel& level : pyr.levels) {
-    const kernel::IcpSystem sys = reduce_icp_system(level.maps, model.view(s.K, s.T_ref), s.T_ref, IcpParams{});
+    const kernel::IcpSystem sys = reduce_icp_system(level.maps, model.view(s.K, s.T_ref), s.T_ref, params);
     out.insert(out.end(), sys.jtj, sys.jtj + 21);
     out.insert(out.end(), sys.jtr, sys.jtr + 6);
     out.push_back(sys.r2);
@@ -169,8 +190,20 @@ std::vector<double> reduced_system(const Device& device) {
   return out;
 }
 
+std::vector<double> default_system(const Device& device) { return reduced_system(device, IcpParams{}); }
+
+TEST(Icp, ReducedSystemWithAModelTermDeviceParity) {
+  IcpParams params;
+  params.model_sigma_m = 0.004f;
+  const std::vector<double> cpu = test::expect_device_parity<double>(
+      [&](const Device& d) { return reduced_system(d, params); }, 1e-4, 1e-4);
+  const std::vector<double> plain = default_system(Device::cpu());
+  ASSERT_EQ(cpu.size(), plain.size());
+  EXPECT_NE(cpu[11], plain[11]) << "the term changed no weight";
+}
+
 TEST(Icp, ReducedSystemDeviceParity) {
-  const std::vector<double> cpu = test::expect_device_parity<double>(reduced_system, 1e-4, 1e-4);
+  const std::vector<double> cpu = test::expect_device_parity<double>(default_system, 1e-4, 1e-4);
   ASSERT_EQ(cpu.size(), 93u);
   EXPECT_GT(cpu[30], 1000.0);  // level 0 has thousands of valid pixels
   EXPECT_GT(cpu[29], 100.0);   // and inliers

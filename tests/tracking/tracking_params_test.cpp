@@ -56,6 +56,14 @@ TEST(TrackingParams, DefaultsAreValidAndBadFieldsAreNamed) {
     EXPECT_NE(std::string(e.what()).find("icp.noise"), std::string::npos);
   }
   n.icp.noise.b = 0.0019f;
+  n.icp.model_sigma_m = -0.001f;
+  try {
+    n.validate();
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("icp.model_sigma_m"), std::string::npos);
+  }
+  n.icp.model_sigma_m = 0.0f;
   n.icp.noise.a = 0.0f;  // σ_n(z0) = 0 would divide by zero
   EXPECT_THROW(n.validate(), std::invalid_argument);
   n.icp.noise_weighting = false;  // the model is not used then
