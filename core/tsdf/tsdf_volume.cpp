@@ -39,10 +39,6 @@ void zero_range(Buffer<T>& b, int64_t from, int64_t to, const Device& device) {
 constexpr int64_t kHashSlotsPerBlock = 4;
 constexpr int64_t kMinHashSlots = 65536;
 
-Eigen::Vector3f block_center(const Eigen::Vector3i& c, float voxel_size) {
-  return (c.cast<float>() * float(kBlockSide) + Eigen::Vector3f::Constant(3.5f)) * voxel_size;
-}
-
 }  // namespace
 
 TsdfVolume::TsdfVolume(const TsdfParams& params, const Device& device) : params_(params), device_(device) {
@@ -379,14 +375,7 @@ int64_t TsdfVolume::stream_in_blocks(std::vector<const BlockData*> back) {
 }
 
 std::vector<Eigen::Vector3i> TsdfVolume::host_block_coords() const {
-  std::vector<uint64_t> keys;
-  keys.reserve(host_blocks_.size());
-  for (const auto& [key, block] : host_blocks_) keys.push_back(key);
-  std::sort(keys.begin(), keys.end());
-  std::vector<Eigen::Vector3i> out;
-  out.reserve(keys.size());
-  for (uint64_t k : keys) out.push_back(block_coord(k));
-  return out;
+  return host_blocks_where([](const Eigen::Vector3i&) { return true; });
 }
 
 kernel::PoolView TsdfVolume::pool() { return {geometry_.span(), attributes_.span()}; }

@@ -35,7 +35,7 @@ ViewFrustum::ViewFrustum(const Intrinsics& K, const Eigen::Isometry3f& T_wc, con
 }
 
 bool ViewFrustum::may_read(const Eigen::Vector3i& coord) const {
-  const Eigen::Vector3f c = (coord.cast<float>() * float(kBlockSide) + Eigen::Vector3f::Constant(3.5f)) * voxel_size_;
+  const Eigen::Vector3f c = block_center(coord, voxel_size_);
   for (const Eigen::Vector4f& p : planes_)
     if (p.head<3>().dot(c) + p.w() < -margin_) return false;
   return true;

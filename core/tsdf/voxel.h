@@ -139,6 +139,10 @@ RRG_HD inline Eigen::Vector3i block_coord(uint64_t key) {
   return {int((key >> (2 * kKeyBits)) & m) - kKeyBias, int((key >> kKeyBits) & m) - kKeyBias,
           int(key & m) - kKeyBias};
 }
+// The centre of block c's voxel centres (voxels 8c .. 8c + 7 on each axis), world metres.
+RRG_HD inline Eigen::Vector3f block_center(const Eigen::Vector3i& c, float voxel_size) {
+  return (c.cast<float>() * float(kBlockSide) + Eigen::Vector3f::Constant(3.5f)) * voxel_size;
+}
 // Floor division by 8 for negative voxel coordinates too.
 RRG_HD inline int block_of(int voxel) { return voxel >> 3; }
 RRG_HD inline int local_of(int voxel) { return voxel & 7; }
