@@ -148,10 +148,9 @@ void ManagedSession::run_one(Item& item) {
       r.mutable_view()->set_map_version(report.map_version);
     }
     const SessionStatus st = session_->status();
-    if (meta_.memory_budget > 0 && st.device_bytes + st.host_bytes > meta_.memory_budget) {
+    if (const std::string over = meta_.budget.excess(st); !over.empty()) {
       std::lock_guard qlock(queue_mutex_);
-      over_budget_ = "session " + meta_.id + " uses " + std::to_string(st.device_bytes + st.host_bytes) +
-                     " bytes, over its memory budget of " + std::to_string(meta_.memory_budget) + " bytes";
+      over_budget_ = "session " + meta_.id + " uses " + over;
       spdlog::warn("{}", over_budget_);
     }
     metrics_.frame_processed(report.times, queue_ms, item.frame.decode_ms + ms_between(item.queued, Clock::now()));

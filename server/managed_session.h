@@ -8,6 +8,7 @@
 #include "core/slam/session.h"
 #include "rrg/v1/service.pb.h"
 #include "server/frame_decode.h"
+#include "server/memory_budget.h"
 #include "server/metrics.h"
 
 #include <chrono>
@@ -30,7 +31,7 @@ struct SessionMeta {
   std::string token_sha256;   // the bearer token's SHA-256 (the token itself is never stored)
   float depth_scale = 1000.0f;
   size_t queue_capacity = 8;
-  size_t memory_budget = 0;   // bytes (device + host), 0 = none
+  MemoryBudget budget;        // the server's per-session limits (a session over them refuses frames)
 };
 
 // Receives the FrameResults of the frames one stream sent. deliver() is called from the worker

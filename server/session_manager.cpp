@@ -129,11 +129,12 @@ SessionManager::~SessionManager() {
   if (reaper_.joinable()) reaper_.join();
 }
 
-size_t SessionManager::used_bytes() const {
-  size_t used = 0;
+SessionStatus SessionManager::used_bytes() const {
+  SessionStatus used;
   for (const auto& [id, s] : sessions_) {
     const SessionStatus st = s->session().status();
-    used += st.device_bytes + st.host_bytes;
+    used.device_bytes += st.device_bytes;
+    used.host_bytes += st.host_bytes;
   }
   return used;
 }
@@ -153,16 +154,19 @@ void SessionManager::admit(size_t extra) const {
   if (n + extra > options_.max_sessions)
     throw exhausted("admission: the server already runs " + std::to_string(n) + " sessions (max " +
                     std::to_string(options_.max_sessions) + ")");
-  if (options_.total_memory_budget > 0) {
-    // Every session may grow to its per-session budget, so that much is reserved per session.
-    const size_t used = used_bytes();
-    const size_t reserve = options_.session_memory_budget;
-    const size_t reserved = std::max(used, (sessions_.size() + reserved_ids_.size()) * reserve);
-    if (reserved + reserve > options_.total_memory_budget || used >= options_.total_memory_budget)
-      throw exhausted("admission: memory budget: " + std::to_string(reserved) + " bytes in use or reserved, a new "
-                      "session reserves " + std::to_string(reserve) + ", total budget " +
-                      std::to_string(options_.total_memory_budget));
-  }
+  if (!options_.total_budget.any()) return;
+  // Every session may grow to its per-session budget, so that much is reserved per session.
+  const SessionStatus st = used_bytes();
+  const size_t sessions = sessions_.size() + reserved_ids_.size();
+  const auto check = [&](const char* what, size_t used, size_t reserve, size_t total) {
+    if (total == 0) return;
+    const size_t reserved = std::max(used, sessions * reserve);
+    if (reserved + reserve > total || used >= total)
+      throw exhausted(std::string("admission: ") + what + ": " + std::to_string(reserved) + " bytes in use or reserved, a new "
+                      "session reserves " + std::to_string(reserve) + ", total budget " + std::to_string(total));
+  };
+  check("memory budget", st.device_bytes + st.host_bytes, options_.session_budget.memory, options_.total_budget.memory);
+  check("device budget", st.device_bytes, options_.session_budget.device, options_.total_budget.device);
 }
 
 bool SessionManager::has_capacity() const {
@@ -213,10 +217,8 @@ v1::CreateSessionResponse SessionManager::create(const grpc::ServerContextBase& 
   v1::CreateSessionResponse out;
   try {
     auto session = std::make_unique<Session>(std::move(config));
-    const SessionStatus st = session->status();
-    if (options_.session_memory_budget > 0 && st.device_bytes + st.host_bytes > options_.session_memory_budget)
-      throw exhausted("admission: a new session takes " + std::to_string(st.device_bytes + st.host_bytes) +
-                      " bytes, over the per-session budget of " + std::to_string(options_.session_memory_budget));
+    if (const std::string over = options_.session_budget.excess(session->status()); !over.empty())
+      throw exhausted("admission: a new session takes " + over + " per session");
     SessionMeta meta;
     meta.id = id;
     meta.name = r.name();
@@ -224,7 +226,7 @@ v1::CreateSessionResponse SessionManager::create(const grpc::ServerContextBase& 
     meta.token_sha256 = sha256_hex(token);
     meta.depth_scale = depth_scale;
     meta.queue_capacity = queue;
-    meta.memory_budget = options_.session_memory_budget;
+    meta.budget = options_.session_budget;
     managed = std::make_shared<ManagedSession>(std::move(meta), std::move(session), metrics_);
     out.set_session_id(managed->meta().id);
     out.set_token(token);
@@ -366,12 +368,14 @@ v1::CreateSessionResponse SessionManager::load(const grpc::ServerContextBase& ct
   std::shared_ptr<ManagedSession> managed;
   try {
     auto session = Session::load(snapshot_file(id));
+    if (const std::string over = options_.session_budget.excess(session->status()); !over.empty())
+      throw exhausted("load: session " + id + " takes " + over + " per session");
     SessionMeta meta;
     meta.id = id;
     meta.name = j.value("name", "");
     meta.depth_scale = j.value("depth_scale", 1000.0f);
     meta.queue_capacity = j.value("queue_capacity", options_.default_queue);
-    meta.memory_budget = options_.session_memory_budget;
+    meta.budget = options_.session_budget;
     // The session's own token keeps working; an admin load issues a new one.
     const std::string new_tok = admin ? new_token() : *token;
     meta.token_sha256 = sha256_hex(new_tok);

@@ -9,6 +9,7 @@
 #include "core/slam/session_config.h"
 #include "rrg/v1/service.pb.h"
 #include "server/managed_session.h"
+#include "server/memory_budget.h"
 #include "server/metrics.h"
 
 #include <grpcpp/server_context.h>
@@ -28,8 +29,8 @@ namespace rrg::server {
 
 struct ManagerOptions {
   size_t max_sessions = 16;
-  size_t session_memory_budget = 0;  // bytes per session (device + host); 0 = none
-  size_t total_memory_budget = 0;    // bytes over all sessions; 0 = none
+  MemoryBudget session_budget;       // per session (server/memory_budget.h); 0 = none
+  MemoryBudget total_budget;         // over all sessions; each session reserves session_budget of it
   size_t default_queue = 8;          // frame queue capacity when Create asks for 0
   size_t max_queue = 256;
   std::filesystem::path snapshot_dir;  // empty = Save / Load / idle snapshots unavailable
@@ -86,7 +87,7 @@ class SessionManager {
  private:
   std::shared_ptr<ManagedSession> find(const std::string& id) const;
   void admit(size_t extra_sessions) const;  // throws RESOURCE_EXHAUSTED; caller holds mutex_
-  size_t used_bytes() const;                // caller holds mutex_
+  SessionStatus used_bytes() const;         // device_bytes and host_bytes summed; caller holds mutex_
   std::filesystem::path snapshot_file(const std::string& id) const;
   std::filesystem::path meta_file(const std::string& id) const;
   void write_meta(const ManagedSession& s) const;

@@ -21,6 +21,7 @@ void register_serve_command(CLI::App& app) {
   auto device = std::make_shared<std::string>("auto");
   auto max_message_mb = std::make_shared<double>(64);
   auto session_mb = std::make_shared<double>(0), total_mb = std::make_shared<double>(0);
+  auto session_device_mb = std::make_shared<double>(0), total_device_mb = std::make_shared<double>(0);
   auto log_json = std::make_shared<bool>(false);
   auto max_sessions = std::make_shared<size_t>(16), queue = std::make_shared<size_t>(8);
   cmd->add_option("--address", o->address, "listen address HOST:PORT (port 0: any free port)")->capture_default_str();
@@ -29,8 +30,16 @@ void register_serve_command(CLI::App& app) {
   cmd->add_option("--port-file", o->port_file, "write the bound port to this file once serving");
   cmd->add_option("--device", *device, "cpu | cuda | cuda:N | auto: where sessions run")->capture_default_str();
   cmd->add_option("--max-sessions", *max_sessions, "admission: live sessions at most")->capture_default_str();
-  cmd->add_option("--session-memory-mb", *session_mb, "admission: memory budget per session, MiB (0 = none)");
-  cmd->add_option("--total-memory-mb", *total_mb, "admission: memory budget of all sessions, MiB (0 = none)");
+  cmd->add_option("--session-memory-mb", *session_mb, "admission: memory budget per session, MiB (0 = none)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--total-memory-mb", *total_mb, "admission: memory budget of all sessions, MiB (0 = none)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--session-device-mb", *session_device_mb,
+                  "admission: device memory budget per session, MiB (0 = none); host memory a session's "
+                  "TSDF streams to (tsdf.stream_radius) does not count")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--total-device-mb", *total_device_mb, "admission: device memory budget of all sessions, MiB (0 = none)")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--queue", *queue, "default frame queue capacity per session")->capture_default_str();
   cmd->add_option("--snapshot-dir", o->manager.snapshot_dir, "folder for Save / Load / idle and shutdown snapshots");
   cmd->add_option("--idle-timeout", o->manager.idle_timeout_s, "seconds without calls before a session is snapshotted and freed (0 = never)");
@@ -64,8 +73,9 @@ void register_serve_command(CLI::App& app) {
     opts.manager.defaults = server::make_server_defaults(*config, *sets);  // refused before anything binds
     opts.manager.max_sessions = *max_sessions;
     opts.manager.default_queue = *queue;
-    opts.manager.session_memory_budget = size_t(*session_mb * 1024.0 * 1024.0);
-    opts.manager.total_memory_budget = size_t(*total_mb * 1024.0 * 1024.0);
+    const auto bytes = [](double mib) { return size_t(mib * 1024.0 * 1024.0); };
+    opts.manager.session_budget = {.memory = bytes(*session_mb), .device = bytes(*session_device_mb)};
+    opts.manager.total_budget = {.memory = bytes(*total_mb), .device = bytes(*total_device_mb)};
     opts.max_message_bytes = int(*max_message_mb * 1024.0 * 1024.0);
     if (opts.viewer_dir.empty()) opts.viewer_dir = server::default_viewer_dir();
     if (opts.manager.admin_key.empty())

@@ -95,7 +95,8 @@ struct Session::Impl {
   // volume lock with every block a camera K at T_wc may read resident (ViewFrustum). The lock is
   // shared when they are (always without streaming); else it is taken alone, the streamed-out
   // ones come back for read() and go out again after it, so a read leaves the volume's residency
-  // as it found it. Should read() throw, they stay until the next frame streams out.
+  // and its pool's size as it found them. Should read() throw, they stay until the next frame
+  // streams out.
   template <class Read>
   auto read_view(const Intrinsics& K_view, const Eigen::Isometry3f& T_wc, Read&& read) const {
     const ViewFrustum frustum(K_view, T_wc, volume.params());
@@ -125,9 +126,11 @@ struct Session::Impl {
     }
     std::unique_lock lock(volume_mutex);
     const std::vector<Eigen::Vector3i> back = volume.host_blocks_where(needs);
+    const int64_t pool = volume.pool_capacity();
     volume.stream_in(back);
     auto result = read();
     volume.stream_out(back);
+    volume.shrink_pool(pool);  // the device memory too, as found (a far render must not grow it for good)
     return result;
   }
   // C_r for the tracking mask, exact where its mean RGB stays <= stop_mean (the mask's threshold)

@@ -38,7 +38,10 @@ TriangleMesh Session::mesh(uint64_t changed_since) const {
     // Streamed out (tsdf.stream_radius): meshed slab by slab with no more blocks resident than
     // now, the same mesh as with every block resident; the resident ones stay so.
     std::unique_lock lock(s.volume_mutex);
-    return extract_mesh_streamed(s.volume, std::max<int64_t>(s.volume.num_blocks(), 1), remap);
+    const int64_t pool = s.volume.pool_capacity();
+    TriangleMesh mesh = extract_mesh_streamed(s.volume, std::max<int64_t>(s.volume.num_blocks(), 1), remap);
+    s.volume.shrink_pool(pool);
+    return mesh;
   }
   std::vector<Eigen::Vector3i> blocks;
   {

@@ -22,6 +22,7 @@
 #include <algorithm>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <stdexcept>
 
@@ -101,7 +102,8 @@ std::vector<uint8_t> volume_bytes(const TsdfVolume& volume, const std::filesyste
   return bytes;
 }
 
-TsdfVolume volume_from_bytes(std::span<const uint8_t> bytes, const Device& device, const std::filesystem::path& beside) {
+TsdfVolume volume_from_bytes(std::span<const uint8_t> bytes, const Device& device, const std::filesystem::path& beside,
+                             const std::function<bool(const Eigen::Vector3i&)>& resident) {
   const auto tmp = std::filesystem::temp_directory_path() /
                    ("rrg-load-" + std::to_string(::getpid()) + "-" + beside.filename().string() + ".tsdf");
   {
@@ -110,7 +112,7 @@ TsdfVolume volume_from_bytes(std::span<const uint8_t> bytes, const Device& devic
     if (!f) throw std::runtime_error("cannot write a temporary file " + tmp.string());
   }
   try {
-    TsdfVolume v = load_volume(tmp, device);
+    TsdfVolume v = load_volume(tmp, device, resident);
     std::filesystem::remove(tmp);
     return v;
   } catch (...) {
@@ -256,7 +258,18 @@ std::unique_ptr<Session> Session::load(const std::filesystem::path& file, std::u
   }
   s.remap = r.get_vector<int32_t>();
   s.mapping.steps = r.get<int64_t>();
-  s.volume = volume_from_bytes(r.get_bytes(), config.device, file);
+  // A session that streams loads its TSDF as the last fusion left it: the blocks beyond
+  // tsdf.stream_radius of that camera in host memory, never in the device pool.
+  std::function<bool(const Eigen::Vector3i&)> resident;
+  const auto last_fused = std::find_if(s.reports.rbegin(), s.reports.rend(), [](const FrameReport& f) { return f.fused; });
+  if (s.config.stream_radius > 0.0f && last_fused != s.reports.rend()) {
+    const Eigen::Vector3f center = last_fused->T_wc.translation();
+    const float radius = s.config.stream_radius;
+    resident = [center, radius, voxel = s.config.tsdf.voxel_size](const Eigen::Vector3i& b) {
+      return (block_center(b, voxel) - center).norm() <= radius;  // TsdfVolume::stream_out's test
+    };
+  }
+  s.volume = volume_from_bytes(r.get_bytes(), config.device, file, resident);
   GaussianHost base = get_gaussians(r);
   GaussianHost refl = get_gaussians(r);
   s.mapping.base_gaussians = int64_t(base.size());

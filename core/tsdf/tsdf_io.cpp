@@ -90,7 +90,8 @@ void save_volume(const TsdfVolume& volume, const std::filesystem::path& path) {
   });
 }
 
-TsdfVolume load_volume(const std::filesystem::path& path, const Device& device) {
+TsdfVolume load_volume(const std::filesystem::path& path, const Device& device,
+                       const std::function<bool(const Eigen::Vector3i&)>& resident) {
   std::ifstream f(path, std::ios::binary);
   if (!f) fail(path, "cannot open file");
   const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
@@ -135,9 +136,10 @@ TsdfVolume load_volume(const std::filesystem::path& path, const Device& device) 
   } catch (const std::invalid_argument& e) {
     fail(path, e.what());
   }
-  prm.initial_blocks = std::max<int64_t>(int64_t(n_blocks), 1);
-  std::vector<BlockData> blocks(n_blocks);
-  for (BlockData& b : blocks) {
+  std::vector<BlockData> blocks, streamed_out;  // resident / loaded into host memory
+  blocks.reserve(resident ? 0 : n_blocks);
+  for (uint64_t i = 0; i < n_blocks; ++i) {
+    BlockData b;
     b.coord.x() = r.get<int32_t>();
     b.coord.y() = r.get<int32_t>();
     b.coord.z() = r.get<int32_t>();
@@ -145,10 +147,13 @@ TsdfVolume load_volume(const std::filesystem::path& path, const Device& device) 
     b.voxels.resize(kBlockVoxels);
     std::memcpy(b.voxels.data(), bytes.data() + r.pos, kBlockVoxels * sizeof(Voxel));
     r.pos += kBlockVoxels * sizeof(Voxel);
+    (!resident || resident(b.coord) ? blocks : streamed_out).push_back(std::move(b));
   }
+  prm.initial_blocks = std::max<int64_t>(int64_t(blocks.size()), 1);
   TsdfVolume volume(prm, device);
   try {
     volume.insert_blocks(blocks);
+    volume.insert_host_blocks(std::move(streamed_out));
   } catch (const std::invalid_argument& e) {
     fail(path, e.what());
   }

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <span>
 
 namespace rrg {
@@ -17,8 +18,11 @@ inline constexpr uint32_t kTsdfFormatVersion = 2;  // 2: the truncation band (k,
 void save_volume(const TsdfVolume& volume, const std::filesystem::path& path);
 
 // Throws std::runtime_error naming the file for a missing file, wrong magic, unsupported version,
-// truncation or checksum mismatch. The volume is created on `device`.
-TsdfVolume load_volume(const std::filesystem::path& path, const Device& device);
+// truncation or checksum mismatch. The volume is created on `device`, with every block resident,
+// or, given `resident`, only the blocks for which resident(coord) holds: the others are loaded
+// streamed out (host memory), and the block pool holds the resident ones alone.
+TsdfVolume load_volume(const std::filesystem::path& path, const Device& device,
+                       const std::function<bool(const Eigen::Vector3i&)>& resident = {});
 
 // 64-bit FNV-1a.
 uint64_t fnv1a64(std::span<const uint8_t> bytes, uint64_t seed = 14695981039346656037ull);

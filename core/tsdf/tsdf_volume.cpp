@@ -131,20 +131,31 @@ std::vector<BlockData> TsdfVolume::read_all_blocks() const {
 }
 
 void TsdfVolume::ensure_pool(int64_t blocks) {
-  const int64_t capacity = int64_t(block_keys_.size());
+  const int64_t capacity = pool_capacity();
   if (blocks <= capacity) return;
   const int64_t bigger = std::max(blocks, capacity + capacity / 2);
   spdlog::debug("tsdf: block pool {} -> {} blocks", capacity, bigger);
-  resize_keep(geometry_, bigger * kBlockVoxels, num_blocks_ * kBlockVoxels, device_);
-  resize_keep(attributes_, bigger * kBlockVoxels, num_blocks_ * kBlockVoxels, device_);
-  zero_range(geometry_, num_blocks_ * kBlockVoxels, bigger * kBlockVoxels, device_);
-  zero_range(attributes_, num_blocks_ * kBlockVoxels, bigger * kBlockVoxels, device_);
-  resize_keep(block_keys_, bigger, num_blocks_, device_);
-  resize_keep(block_versions_, bigger, num_blocks_, device_);
-  resize_keep(block_stamps_, bigger, num_blocks_, device_);
-  resize_keep(crossing_boxes_, bigger, num_blocks_, device_);
-  zero_range(crossing_boxes_, num_blocks_, bigger, device_);
-  resize_keep(active_, bigger, int64_t(active_.size()), device_);
+  resize_pool(bigger);
+}
+
+void TsdfVolume::shrink_pool(int64_t blocks) {
+  const int64_t smaller = std::max({blocks, num_blocks_, int64_t(1)});
+  if (smaller >= pool_capacity()) return;
+  spdlog::debug("tsdf: block pool {} -> {} blocks", pool_capacity(), smaller);
+  resize_pool(smaller);
+}
+
+void TsdfVolume::resize_pool(int64_t capacity) {
+  resize_keep(geometry_, capacity * kBlockVoxels, num_blocks_ * kBlockVoxels, device_);
+  resize_keep(attributes_, capacity * kBlockVoxels, num_blocks_ * kBlockVoxels, device_);
+  zero_range(geometry_, num_blocks_ * kBlockVoxels, capacity * kBlockVoxels, device_);
+  zero_range(attributes_, num_blocks_ * kBlockVoxels, capacity * kBlockVoxels, device_);
+  resize_keep(block_keys_, capacity, num_blocks_, device_);
+  resize_keep(block_versions_, capacity, num_blocks_, device_);
+  resize_keep(block_stamps_, capacity, num_blocks_, device_);
+  resize_keep(crossing_boxes_, capacity, num_blocks_, device_);
+  zero_range(crossing_boxes_, num_blocks_, capacity, device_);
+  resize_keep(active_, capacity, std::min(capacity, int64_t(active_.size())), device_);
 }
 
 void TsdfVolume::rehash(int64_t capacity) {
@@ -251,6 +262,28 @@ void TsdfVolume::insert_blocks(std::span<const BlockData> blocks) {
   ptrs.reserve(blocks.size());
   for (const BlockData& b : blocks) ptrs.push_back(&b);
   insert_block_ptrs(ptrs);
+}
+
+void TsdfVolume::insert_host_blocks(std::vector<BlockData> blocks) {
+  if (blocks.empty()) return;
+  const auto existing = download_prefix(block_keys_, num_blocks_);
+  std::vector<uint64_t> present(existing);
+  std::sort(present.begin(), present.end());
+  std::vector<uint64_t> keys;
+  keys.reserve(blocks.size());
+  for (const BlockData& b : blocks) {
+    if (!block_in_range(b.coord.x(), b.coord.y(), b.coord.z()) || b.voxels.size() != size_t(kBlockVoxels))
+      throw std::invalid_argument("TsdfVolume::insert_host_blocks: block out of range or not 512 voxels");
+    const uint64_t key = block_key(b.coord.x(), b.coord.y(), b.coord.z());
+    if (std::binary_search(present.begin(), present.end(), key) || host_blocks_.count(key))
+      throw std::invalid_argument("TsdfVolume::insert_host_blocks: block already present");
+    keys.push_back(key);
+  }
+  std::vector<uint64_t> sorted(keys);
+  std::sort(sorted.begin(), sorted.end());
+  if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
+    throw std::invalid_argument("TsdfVolume::insert_host_blocks: block listed twice");
+  for (size_t j = 0; j < blocks.size(); ++j) host_blocks_.emplace(keys[j], std::move(blocks[j]));
 }
 
 void TsdfVolume::insert_block_ptrs(std::span<const BlockData* const> blocks) {

@@ -54,6 +54,7 @@ class TsdfVolume {
   int64_t num_blocks() const { return num_blocks_; }                     // resident on the device
   int64_t num_host_blocks() const { return int64_t(host_blocks_.size()); }  // streamed out
   int64_t hash_capacity() const { return int64_t(hash_keys_.size()); }
+  int64_t pool_capacity() const { return int64_t(block_keys_.size()); }  // blocks the pool holds room for
   uint64_t version() const { return version_; }  // number of integrated frames (and loads)
   MemoryUsage memory() const;
 
@@ -74,6 +75,9 @@ class TsdfVolume {
   int64_t stream_out(const Eigen::Vector3f& center, float radius);
   int64_t stream_in(const Eigen::Vector3f& center, float radius);
   int64_t stream_in_all();
+  // Gives back the pool's room beyond max(blocks, num_blocks()) blocks: after a read brought many
+  // streamed-out blocks back and sent them out again, the pool returns to its size before.
+  void shrink_pool(int64_t blocks);
   // The same for listed blocks: coordinates not resident (for stream_out) or not streamed out
   // (for stream_in) are ignored.
   int64_t stream_out(std::span<const Eigen::Vector3i> blocks);
@@ -106,6 +110,9 @@ class TsdfVolume {
                                           const Eigen::Matrix3f& R_wc, const Eigen::Vector3f& t_wc);
   // Adds blocks that are not in the volume (files, streaming). Throws if one is already present.
   void insert_blocks(std::span<const BlockData> blocks);
+  // The same, straight into host memory, as stream_out leaves blocks (a file loaded by a session
+  // that streams: its far blocks never take pool slots).
+  void insert_host_blocks(std::vector<BlockData> blocks);
   void set_version(uint64_t v) { version_ = v; }
   // Per-frame images of integrate(), kept between frames so that fusing a frame allocates nothing
   // once the first frame of a size has been fused: V_k^l, N_k^l and the per-pixel fusion data.
@@ -117,6 +124,7 @@ class TsdfVolume {
 
  private:
   void ensure_pool(int64_t blocks);       // pool capacity >= blocks (copying)
+  void resize_pool(int64_t capacity);     // capacity >= num_blocks_, copying the resident blocks
   void rehash(int64_t capacity);          // new table of `capacity` slots with every resident block
   void grow_hash_for(int64_t blocks);     // keeps the load factor <= 1/2
   void append_blocks(std::span<const uint64_t> keys, std::span<const int64_t> slots,

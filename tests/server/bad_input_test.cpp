@@ -3,6 +3,7 @@
 #include "client/lib/frame_encode.h"
 #include "client/lib/proto_convert.h"
 #include "tests/server/server_fixture.h"
+#include "tests/support/test_support.h"
 
 #include <gtest/gtest.h>
 #include <grpcpp/generic/generic_stub.h>
@@ -240,6 +241,83 @@ TEST(Admission, SessionCountAndMemoryBudgetsGiveResourceExhausted) {
     EXPECT_NO_THROW(c.create(create_request()));
     expect_status([&] { c.create(create_request()); }, grpc::StatusCode::RESOURCE_EXHAUSTED, "memory budget");
   }
+}
+
+// --session-device-mb counts device memory alone. A session whose TSDF streams its far blocks to
+// the host (tsdf.stream_radius) loads within a device budget that the same map held whole
+// exceeds; the latter is refused and its snapshot left as it was. A session growing over the
+// budget refuses its next frame, naming the device budget.
+TEST(Admission, ADeviceBudgetLeavesOutTheBlocksATsdfStreamsToTheHost) {
+  TempDir snaps("rrg-device-budget");
+  auto whole_req = create_request();
+  whole_req.set_session_id("whole-map");
+  auto streamed_req = whole_req;
+  streamed_req.set_session_id("streamed-map");
+  (*streamed_req.mutable_config())["tsdf.stream_radius"] = "0.5";
+  std::map<std::string, std::string> tokens;
+  {
+    ServerProcess s({}, snaps.path());
+    auto c = s.client();
+    for (const auto* req : {&whole_req, &streamed_req}) {
+      const auto cr = c.create(*req);
+      tokens[cr.session_id()] = cr.token();
+      stream_frames(c, {cr.session_id(), cr.token()}, 0, wire_frames().size());
+      c.close({cr.session_id(), cr.token()}, true);
+    }
+  }
+  // What each takes once loaded (the server loads the same files the same way).
+  const SessionStatus whole = Session::load(snaps.path() / "whole-map.rrgsnap")->status();
+  const SessionStatus streamed = Session::load(snaps.path() / "streamed-map.rrgsnap")->status();
+  ASSERT_GT(streamed.host_bytes, 0u);
+  ASSERT_LT(streamed.device_bytes, whole.device_bytes * 3 / 4) << "too little was streamed out to test anything";
+  const size_t budget = streamed.device_bytes + (whole.device_bytes - streamed.device_bytes) / 2;
+  // A memory budget (device + host) of that size would refuse both.
+  ASSERT_GT(streamed.device_bytes + streamed.host_bytes, budget);
+  char mib[64];
+  std::snprintf(mib, sizeof(mib), "%.6f", double(budget) / (1024.0 * 1024.0));
+
+  ServerProcess s({"--session-device-mb", mib}, snaps.path());
+  auto c = s.client();
+  const auto snapshot_bytes = [&] { return std::filesystem::file_size(snaps.path() / "whole-map.rrgsnap"); };
+  const auto size_before = snapshot_bytes();
+  expect_status([&] { c.load("whole-map", tokens["whole-map"]); }, grpc::StatusCode::RESOURCE_EXHAUSTED, "device budget");
+  EXPECT_EQ(snapshot_bytes(), size_before) << "a refused load touched the snapshot";
+  const auto loaded = c.load("streamed-map", tokens["streamed-map"]);
+  const SessionHandle h{loaded.session_id(), tokens["streamed-map"]};
+  EXPECT_LE(loaded.info().device_bytes(), budget);
+  EXPECT_EQ(loaded.info().host_bytes(), streamed.host_bytes);
+  EXPECT_EQ(loaded.info().tsdf_resident_blocks(), uint64_t(streamed.resident_blocks));
+  // Frames go on: this small room is all in view, so the next frame brings every block back and
+  // the session grows over its budget; the frame after that is refused.
+  v1::FrameResult last;
+  uint64_t id = wire_frames().back().id();
+  for (int k = 0; k < 2; ++k) {
+    v1::Frame f = wire_frames()[wire_frames().size() - 2 + size_t(k)];
+    f.set_id(++id);
+    f.clear_pose_prior();
+    c.stream(h, [&, sent = false]() mutable -> std::optional<v1::Frame> {
+          if (sent) return std::nullopt;
+          sent = true;
+          return f;
+        },
+        [&](const v1::FrameResult& r, double) { last = r; });
+    if (k == 0) {
+      EXPECT_FALSE(last.has_error()) << last.error().message();
+      EXPECT_GT(c.get(h).device_bytes(), budget);
+    }
+  }
+  ASSERT_TRUE(last.has_error()) << "a session over its device budget took a frame";
+  EXPECT_EQ(last.error().code(), int(grpc::StatusCode::RESOURCE_EXHAUSTED));
+  EXPECT_NE(last.error().message().find("device budget"), std::string::npos) << last.error().message();
+
+  // Admission: each session reserves its device budget out of the total.
+  ServerProcess t({"--session-device-mb", "512", "--total-device-mb", "1000"});
+  auto ct = t.client();
+  EXPECT_NO_THROW(ct.create(create_request()));
+  expect_status([&] { ct.create(create_request()); }, grpc::StatusCode::RESOURCE_EXHAUSTED, "device budget");
+  ServerProcess u({"--session-device-mb", "0.01"});  // 10 KiB: no session fits
+  auto cu = u.client();
+  expect_status([&] { cu.create(create_request()); }, grpc::StatusCode::RESOURCE_EXHAUSTED, "device budget");
 }
 
 TEST(Queue, AFullQueueDropsTheOldestFrameAndSaysSo) {

@@ -76,6 +76,7 @@ TEST_F(SessionStreamingTest, AStreamedSessionIsTheSessionThatHoldsEverything) {
     expect_same_images(whole.render(c.K, T), streamed.render(c.K, T), "render");
   }
   EXPECT_EQ(streamed.status().resident_blocks, resident) << "a render left blocks resident";
+  EXPECT_EQ(streamed.status().tsdf_device_bytes, b.tsdf_device_bytes) << "a render grew the device pool for good";
 
   // Meshes: whole, changed since a version, the viewer's blocks.
   expect_same_mesh(whole.mesh(), streamed.mesh(), "mesh()");
@@ -94,6 +95,48 @@ TEST_F(SessionStreamingTest, AStreamedSessionIsTheSessionThatHoldsEverything) {
   const std::vector<Eigen::Vector3i> some(all.begin(), all.begin() + std::ptrdiff_t(all.size() / 3));
   expect_same_mesh(whole.mesh_of_blocks(some), streamed.mesh_of_blocks(some), "mesh_of_blocks");
   EXPECT_EQ(streamed.status().resident_blocks, resident) << "a mesh left blocks resident";
+  EXPECT_EQ(streamed.status().tsdf_device_bytes, b.tsdf_device_bytes) << "a mesh grew the device pool for good";
+}
+
+// Save / Load (the service's snapshots, idle timeouts, drains) keep a streaming session's far
+// blocks in host memory: the loaded session's device pool holds what the last frame left resident.
+TEST_F(SessionStreamingTest, ALoadedStreamingSessionKeepsItsFarBlocksOnTheHost) {
+  const auto d = io::open_dataset(root());
+  SessionConfig c = base_config(*d);
+  c.mapping_period = 5;
+  c.tsdf.max_depth = 4.0f;
+  c.stream_radius = 2.5f;  // some blocks stay resident, more go out
+  c.tsdf.initial_blocks = 64;  // the pool grows with what stays resident
+  const test::TempDir dir("stream-snap");
+  Session first(c);
+  for (size_t i = 0; i < 16; ++i) first.process(frame(*d, i, i == 0));
+  first.save(dir / "s.rrgs");
+  const SessionStatus saved = first.status();
+  ASSERT_GT(saved.resident_blocks, 0);
+  ASSERT_LT(saved.resident_blocks, saved.tsdf_blocks / 2) << "too little was streamed out to test anything";
+  const auto loaded = Session::load(dir / "s.rrgs");
+  const SessionStatus st = loaded->status();
+  EXPECT_EQ(st.tsdf_blocks, saved.tsdf_blocks);
+  EXPECT_EQ(st.resident_blocks, saved.resident_blocks);
+  EXPECT_EQ(st.host_bytes, saved.host_bytes);
+  EXPECT_LE(st.tsdf_device_bytes, saved.tsdf_device_bytes);
+  // Its pool holds the resident blocks alone, so reads of the far blocks grow it, and give it back.
+  const Eigen::Isometry3f T0 = d->load(0).T_wc_gt->cast<float>();
+  expect_same_images(first.render(c.K, T0), loaded->render(c.K, T0), "render at the first pose");
+  EXPECT_EQ(loaded->status().tsdf_device_bytes, st.tsdf_device_bytes) << "a render grew the device pool for good";
+  expect_same_mesh(first.mesh(), loaded->mesh(), "mesh() after loading");
+  EXPECT_EQ(loaded->status().tsdf_device_bytes, st.tsdf_device_bytes) << "a mesh grew the device pool for good";
+  EXPECT_EQ(loaded->status().resident_blocks, st.resident_blocks);
+  // It goes on as the session that was never saved.
+  for (size_t i = 16; i < 32; ++i) {
+    const FrameReport a = first.process(frame(*d, i, false));
+    const FrameReport b = loaded->process(frame(*d, i, false));
+    ASSERT_TRUE(a.T_wc.matrix() == b.T_wc.matrix()) << "frame " << i;
+  }
+  first.finish();
+  loaded->finish();
+  EXPECT_EQ(loaded->status().resident_blocks, first.status().resident_blocks);
+  expect_same_mesh(first.mesh(), loaded->mesh(), "mesh()");
 }
 
 TEST_F(SessionStreamingTest, ANegativeRadiusIsRefused) {

@@ -90,6 +90,41 @@ TEST(TsdfIo, SaveLoadRoundTripIsIdenticalOnEveryDevice) {
   }
 }
 
+// A file loaded with a residency rule: the blocks it rejects go straight to host memory, as
+// stream_out would have put them; nothing is lost and the pool holds the resident blocks alone.
+TEST(TsdfIo, LoadingWithAResidencyRuleStreamsTheOtherBlocksOut) {
+  const test::TempDir tmp("tsdf-io-resident");
+  const auto novel = test::look_at({0.5f, 0.3f, -0.6f}, {0, 0, 0});
+  for (const Device& device : available_devices()) {
+    SCOPED_TRACE(device.to_string());
+    const TsdfVolume a = fused(device);
+    save_volume(a, tmp / "v.tsdf");
+    const auto upper = [](const Eigen::Vector3i& b) { return b.y() >= 0; };  // about half the sphere
+    TsdfVolume b = load_volume(tmp / "v.tsdf", device, upper);
+    const TsdfVolume whole = load_volume(tmp / "v.tsdf", device);
+    int64_t kept = 0;
+    for (const BlockData& blk : a.read_all_blocks()) kept += upper(blk.coord);
+    ASSERT_GT(kept, 0);
+    ASSERT_LT(kept, a.num_blocks());
+    EXPECT_EQ(b.num_blocks(), kept);
+    EXPECT_EQ(b.num_host_blocks(), a.num_blocks() - kept);
+    for (const Eigen::Vector3i& c : b.block_coords()) EXPECT_TRUE(upper(c));
+    for (const Eigen::Vector3i& c : b.host_block_coords()) EXPECT_FALSE(upper(c));
+    EXPECT_EQ(b.version(), a.version());
+    EXPECT_EQ(test::flatten_voxels(b), test::flatten_voxels(a));  // every block, wherever it is held
+    EXPECT_LT(b.memory().device_bytes, whole.memory().device_bytes) << "the pool was sized for every block";
+    EXPECT_GT(b.memory().host_bytes, 0u);
+    // A block the volume holds already, resident or not, is refused.
+    EXPECT_THROW(b.insert_host_blocks({*a.read_block(b.block_coords().front())}), std::invalid_argument);
+    EXPECT_THROW(b.insert_host_blocks({*a.read_block(b.host_block_coords().front())}), std::invalid_argument);
+    // Brought back, they are the volume the file holds.
+    EXPECT_EQ(b.stream_in_all(), a.num_blocks() - kept);
+    const RaycastResult ra = raycast(a, kK, novel), rb = raycast(b, kK, novel);
+    EXPECT_EQ(image_bytes(ra.depth), image_bytes(rb.depth));
+    EXPECT_EQ(image_bytes(ra.color_variance), image_bytes(rb.color_variance));
+  }
+}
+
 void expect_load_error(const std::filesystem::path& p, const std::string& what) {
   try {
     load_volume(p, Device::cpu());

@@ -115,6 +115,45 @@ TEST(TsdfStorage, StreamingOutAndBackInIsExact) {
   }
 }
 
+// shrink_pool gives back the room beyond the resident blocks (never below them) and changes no
+// voxel; the pool grows again when blocks come back.
+TEST(TsdfStorage, ShrinkingThePoolKeepsTheResidentBlocks) {
+  const Eigen::Vector3f c(0, 0, 0);
+  const test::Scene scene = test::sphere_scene(c, 0.25f);
+  const auto novel = test::look_at({0.5f, 0.4f, -0.6f}, c);
+  for (const Device& device : available_devices()) {
+    SCOPED_TRACE(device.to_string());
+    TsdfVolume v(params(), device);
+    test::fuse_scene(v, scene, kK, test::cameras_around(c, 0.9f));
+    const auto before = test::flatten_voxels(v);
+    const auto depth_before = raycast(v, kK, novel).depth.to_host();
+    const int64_t total = v.num_blocks();
+    ASSERT_GE(v.pool_capacity(), total);
+    v.stream_out({0.3f, 0, 0}, 0.3f);
+    const int64_t resident = v.num_blocks();
+    const size_t bytes = v.memory().device_bytes;
+    v.shrink_pool(0);  // never below the resident blocks
+    EXPECT_EQ(v.pool_capacity(), resident);
+    EXPECT_LT(v.memory().device_bytes, bytes);
+    EXPECT_EQ(test::flatten_voxels(v), before);
+    v.shrink_pool(total);  // no growth either
+    EXPECT_EQ(v.pool_capacity(), resident);
+    EXPECT_EQ(v.stream_in_all(), total - resident);
+    EXPECT_GE(v.pool_capacity(), total);
+    EXPECT_EQ(test::flatten_voxels(v), before);
+    const auto depth_after = raycast(v, kK, novel).depth.to_host();
+    EXPECT_TRUE(std::equal(depth_after.pixels().begin(), depth_after.pixels().end(), depth_before.pixels().begin()));
+    // Fusion after a shrink: new blocks take the zeroed free slots as before.
+    v.stream_out({0.3f, 0, 0}, 0.3f);
+    v.shrink_pool(0);
+    test::fuse_scene(v, scene, kK, test::cameras_around(c, 0.9f));
+    TsdfVolume w(params(), device);
+    test::fuse_scene(w, scene, kK, test::cameras_around(c, 0.9f));
+    test::fuse_scene(w, scene, kK, test::cameras_around(c, 0.9f));
+    EXPECT_EQ(test::flatten_voxels(v), test::flatten_voxels(w));
+  }
+}
+
 // Listed blocks move and nothing else: coordinates never allocated, out of the key range or
 // already in the other place are ignored.
 TEST(TsdfStorage, StreamingListedBlocksMovesExactlyThose) {
