@@ -80,7 +80,7 @@ void run_track(const TrackOptions& o) {
                device.to_string(), to_string(params.mode), tsdf.to_string());
 
   io::Trajectory trajectory;
-  std::string log = "frame,timestamp,state,icp_inlier_ratio,icp_rmse_mm,icp_iterations,orb_keypoints,orb_matches,"
+  std::string log = "frame,timestamp,state,icp_agreement,icp_inlier_ratio,icp_rmse_mm,icp_iterations,orb_keypoints,orb_matches,"
                     "orb_inliers,orb_refined,relocalised,keyframe,ms_raycast,ms_preprocess,ms_icp,ms_orb,ms_fuse,note\n";
   double t_load = 0, t_raycast = 0, t_pre = 0, t_icp = 0, t_orb = 0, t_fuse = 0;
   size_t counts[3] = {0, 0, 0}, refined = 0, relocalised = 0, tracked = 0;
@@ -124,8 +124,8 @@ void run_track(const TrackOptions& o) {
     if (r.state != TrackingState::Ok || !r.note.empty())
       spdlog::debug("track: frame {}: {} {}", i, to_string(r.state), r.note);
     if (r.state == TrackingState::Lost) spdlog::warn("track: frame {} lost ({})", i, r.note);
-    log += fmt::format("{},{:.6f},{},{:.4f},{:.3f},{},{},{},{},{},{},{},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},\"{}\"\n", i,
-                       frame.timestamp, to_string(r.state), r.icp.inlier_ratio, r.icp.rmse_m * 1e3, r.icp.iterations,
+    log += fmt::format("{},{:.6f},{},{:.4f},{:.4f},{:.3f},{},{},{},{},{},{},{},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},\"{}\"\n", i,
+                       frame.timestamp, to_string(r.state), r.icp.agreement, r.icp.inlier_ratio, r.icp.rmse_m * 1e3, r.icp.iterations,
                        r.orb_keypoints, r.orb_matches, r.orb_inliers, int(r.orb_refined), int(r.relocalised),
                        int(r.keyframe), ms_raycast, r.ms_preprocess, r.ms_icp, r.ms_orb, ms_fuse, r.note);
     if ((i + 1) % size_t(std::max(1, o.progress)) == 0 || i + 1 == n)

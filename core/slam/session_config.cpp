@@ -231,7 +231,9 @@ std::vector<ConfigField> config_fields(SessionConfig& c) {
   t.i("tracking.icp.iterations2", c.tracking.icp.iterations[2], "ICP iterations, level 2");
   t.f("tracking.icp.max_distance_m", c.tracking.icp.max_distance_m, "ICP pair distance limit, metres");
   t.f("tracking.icp.max_normal_angle_deg", c.tracking.icp.max_normal_angle_deg, "ICP normal angle limit");
-  t.f("tracking.icp.min_inlier_ratio", c.tracking.icp.min_inlier_ratio, "below: ICP failed");
+  t.f("tracking.icp.min_agreement", c.tracking.icp.min_agreement, "share of pixels agreeing with the model below which ICP failed");
+  t.f("tracking.icp.ok_agreement", c.tracking.icp.ok_agreement, "below (and above min_agreement): tracking degraded");
+  t.f("tracking.icp.agreement_sigmas", c.tracking.icp.agreement_sigmas, "a pair agrees when |r| <= max(huber δ, k σ_n(z))");
   t.f("tracking.icp.huber_delta_m", c.tracking.icp.huber_delta_m,
       "ICP Huber threshold, metres (on residuals scaled to the reference depth's noise)");
   t.b("tracking.icp.noise_weighting", c.tracking.icp.noise_weighting,

@@ -41,9 +41,9 @@ kernel::IcpSystem reduce_icp_system(const VertexNormalMaps& source, const IcpMod
                        model.normals->view(), model.K, T_ref_cw.linear(), T_ref_cw.translation(),
                        T_wc.linear(), T_wc.translation(), params.max_distance_m,
                        float(std::cos(params.max_normal_angle_deg * std::numbers::pi / 180.0)),
-                       params.huber_delta_m, DepthNoiseModel{}, 0.0f};  // noise weighting off unless asked
+                       params.huber_delta_m, params.noise, 0.0f};  // noise weighting off unless asked
+  args.agree_sigmas = params.agreement_sigmas;
   if (params.noise_weighting) {
-    args.noise = params.noise;
     args.sigma_ref = params.noise.sigma(params.noise_reference_depth_m);
     if (params.model_sigma_m > 0.0f) {
       args.model_variance = params.model_sigma_m * params.model_sigma_m;
@@ -99,6 +99,8 @@ IcpResult icp_align(const FramePyramid& frame, const IcpModel& model, const Eige
   result.inliers = int64_t(s.inliers);
   result.valid = int64_t(s.valid);
   result.inlier_ratio = s.valid > 0 ? float(s.inliers / s.valid) : 0.0f;
+  result.agreeing = int64_t(s.agree);
+  result.agreement = s.valid > 0 ? float(s.agree / s.valid) : 0.0f;
   result.rmse_m = s.inliers > 0 ? float(std::sqrt(s.r2 / s.inliers)) : 0.0f;
   result.rmse_ref_m = s.inliers > 0 ? float(std::sqrt(s.r2_ref / s.inliers)) : 0.0f;
   result.jtj = full_jtj(s);

@@ -29,7 +29,9 @@ struct IcpResult {
   bool diverged = false;       // the result jumped too far from the initial pose
   int64_t inliers = 0;         // level 0 pairs that passed rejection at the final pose
   int64_t valid = 0;           // level 0 pixels with a vertex and a normal
-  float inlier_ratio = 0.0f;   // inliers / valid: the quality measure of the state machine
+  float inlier_ratio = 0.0f;   // inliers / valid
+  int64_t agreeing = 0;        // level 0 pairs within max_distance whose |r| <= max(δ, k σ_n(z)), any normal
+  float agreement = 0.0f;      // agreeing / valid: the quality measure of the state machine
   float rmse_m = 0.0f;         // RMS point-to-plane residual of the inliers
   float rmse_ref_m = 0.0f;     // the same of the residuals scaled to the reference noise (= rmse_m
                                // without noise weighting): the σ that goes with jtj

@@ -20,6 +20,8 @@ struct IcpSystem {
                      // scale in the units the weights of JᵀWJ assume
   double inliers;    // pixels that passed association and rejection
   double valid;      // source pixels with a vertex and a normal
+  double agree;      // associated pixels within max_distance whose |r| <= max(δ, k σ_n(z)), whatever
+                     // their normals (the tracking state's measure, IcpParams::min_agreement)
 };
 
 struct IcpSystemSum {
@@ -31,6 +33,7 @@ struct IcpSystemSum {
     s.r2_ref = a.r2_ref + b.r2_ref;
     s.inliers = a.inliers + b.inliers;
     s.valid = a.valid + b.valid;
+    s.agree = a.agree + b.agree;
     return s;
   }
 };
@@ -39,7 +42,7 @@ RRG_HD inline IcpSystem icp_system_zero() {
   IcpSystem s;
   for (int k = 0; k < 21; ++k) s.jtj[k] = 0.0;
   for (int k = 0; k < 6; ++k) s.jtr[k] = 0.0;
-  s.r2 = s.r2_ref = s.inliers = s.valid = 0.0;
+  s.r2 = s.r2_ref = s.inliers = s.valid = s.agree = 0.0;
   return s;
 }
 
@@ -62,6 +65,9 @@ struct IcpArgs {
   float sigma_ref = 0.0f;
   // σ_m² of the model surface (IcpParams::model_sigma_m), added to σ_n(z)² (sigma_ref includes it)
   float model_variance = 0.0f;
+  // A pair agrees with the model when |r| <= max(huber_delta, agree_sigmas σ_n(z)) (`noise` is the
+  // sensor's model with or without weighting).
+  float agree_sigmas = 3.0f;
 };
 
 // Rounded single-precision multiply and add that the compiler may not fuse into an FMA. The
@@ -105,7 +111,8 @@ RRG_HD inline void project_round(const Intrinsics& K, const Eigen::Vector3f& p, 
 // |p − q| > max_distance or ∠(R N_k^l(u), m) exceeds the angle. Residual r = (p − q)·m, Jacobian
 // for the left update T ← exp(ξ) T, ξ = [ρ; φ]:  J = [mᵀ, (p × m)ᵀ]. With noise weighting the
 // residual is scaled to the reference noise, r̃ = r s with s = σ_ref / σ_n(z), and the weight is
-// w = s² min(1, δ/|r̃|) (Huber on r̃); without it s = 1.
+// w = s² min(1, δ/|r̃|) (Huber on r̃); without it s = 1. Before the normal test, a pair whose
+// |r| <= max(δ, k σ_n(z)) counts as agreeing with the model (the quality measure).
 // Adds the pixel's share to s (the valid count, and the normal equations when it is an inlier);
 // accumulating in place keeps the CPU loop free of a 30-double temporary per pixel.
 RRG_HD inline void icp_accumulate(const IcpArgs& a, int64_t i, IcpSystem& s) {
@@ -124,11 +131,12 @@ RRG_HD inline void icp_accumulate(const IcpArgs& a, int64_t i, IcpSystem& s) {
   const Eigen::Vector3f q = a.model_vertices(ux, uy);
   const Eigen::Vector3f d = p - q;
   if (d.squaredNorm() > a.max_distance * a.max_distance) return;
-  if ((a.R_wc * n).dot(m) < a.min_cos) return;
   const float r = d.dot(m);
+  const float sigma = a.noise.sigma(v.z());
+  if (fabsf(r) <= fmaxf(a.huber_delta, a.agree_sigmas * sigma)) s.agree += 1.0;
+  if ((a.R_wc * n).dot(m) < a.min_cos) return;
   float scale = 1.0f;  // s = σ_ref / σ_n(z), or with a model term σ_ref / sqrt(σ_n(z)² + σ_m²)
   if (a.sigma_ref > 0.0f) {
-    const float sigma = a.noise.sigma(v.z());
     scale = a.model_variance > 0.0f ? a.sigma_ref / sqrtf(sigma * sigma + a.model_variance) : a.sigma_ref / sigma;
   }
   const float r_ref = r * scale;

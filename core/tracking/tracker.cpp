@@ -75,7 +75,7 @@ void Tracker::import_state(const TrackerState& s) {
 }
 
 bool Tracker::icp_failed(const IcpResult& icp) const {
-  return icp.diverged || icp.valid == 0 || icp.inlier_ratio < params_.icp.min_inlier_ratio;
+  return icp.diverged || icp.valid == 0 || icp.agreement < params_.icp.min_agreement;
 }
 
 void Tracker::add_keyframe(size_t index, const Eigen::Isometry3f& T_wc, const OrbFrame& orb) {
@@ -157,7 +157,7 @@ TrackResult Tracker::track(const TrackInput& in, ModelSource& model, MaskSource*
       return r;
     }
     r.relocalised = true;
-    r.note = "icp failed (inlier ratio " + std::to_string(r.icp.inlier_ratio) + "); relocalised against keyframe " +
+    r.note = "icp failed (agreement " + std::to_string(r.icp.agreement) + "); relocalised against keyframe " +
              std::to_string(reloc.keyframe_id) + " (" + std::to_string(reloc.inliers) + " inliers)";
   }
   r.T_wc = r.icp.T_wc;
@@ -207,7 +207,7 @@ TrackResult Tracker::track(const TrackInput& in, ModelSource& model, MaskSource*
     r.ms_orb += ms_since(t0);
   }
 
-  r.state = r.relocalised || r.icp.inlier_ratio < params_.icp.ok_inlier_ratio ? TrackingState::Degraded : TrackingState::Ok;
+  r.state = r.relocalised || r.icp.agreement < params_.icp.ok_agreement ? TrackingState::Degraded : TrackingState::Ok;
   state_ = r.state;
   if (r.state == TrackingState::Ok &&
       (keyframes_.empty() || needs_keyframe(keyframes_.back().T_wc, r.T_wc, params_.keyframes))) {  // empty after resume()

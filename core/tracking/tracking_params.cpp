@@ -38,8 +38,9 @@ void TrackingParams::validate() const {
     // σ_n(z) >= a, its value at z0: a > 0 keeps every pair's weight finite.
     if (!(icp.noise.a > 0)) fail("icp.noise.a must be > 0 with noise weighting (σ_n(z) >= a divides the residuals)");
   }
-  if (!(icp.min_inlier_ratio >= 0 && icp.min_inlier_ratio <= icp.ok_inlier_ratio && icp.ok_inlier_ratio <= 1))
-    fail("icp inlier ratios must satisfy 0 <= min <= ok <= 1");
+  if (!(icp.agreement_sigmas > 0)) fail("icp.agreement_sigmas must be > 0");
+  if (!(icp.min_agreement >= 0 && icp.min_agreement <= icp.ok_agreement && icp.ok_agreement <= 1))
+    fail("icp.min_agreement and icp.ok_agreement must satisfy 0 <= min <= ok <= 1");
   if (orb.features < 10) fail("orb.features must be >= 10");
   if (!(orb.ratio > 0 && orb.ratio <= 1)) fail("orb.ratio must be in (0, 1]");
   if (!(orb.icp_prior_scale >= 0)) fail("orb.icp_prior_scale must be >= 0");

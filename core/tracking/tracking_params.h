@@ -40,8 +40,15 @@ struct IcpParams {
   // "A model term beside σ_n(z)".
   float model_sigma_m = 0.0f;
   DepthNoiseModel noise;
-  float min_inlier_ratio = 0.25f; // below: ICP failed (diverged or no overlap)
-  float ok_inlier_ratio = 0.50f;  // below (and above min): tracking degraded
+  // The tracking state's quality measure, IcpResult::agreement: the share of the frame's valid
+  // pixels whose pair agrees with the model, |p − q| <= max_distance and a point-to-plane residual
+  // the sensor's noise explains, |r| <= max(huber_delta, agreement_sigmas σ_n(z)). The normal-angle
+  // rejection is left out of it: normals from depth 3–4 m away (σ_n 2–3 cm over a 1.4 cm pixel
+  // footprint) differ by more than 30° on most pairs of a correct pose, and a room seen from its
+  // far side would read as lost (docs/tracking.md "Agreement, not inliers").
+  float agreement_sigmas = 3.0f;
+  float min_agreement = 0.25f;    // below: ICP failed (diverged or no overlap)
+  float ok_agreement = 0.50f;     // below (and above min): tracking degraded
   float max_jump_m = 0.30f;       // an ICP step farther than this from the motion prior diverged
   float max_jump_deg = 30.0f;
   // Stop a level when the update moves the scene by less than ~0.1 mm: |ρ| < 0.1 mm and |φ| < 1e-4

@@ -98,11 +98,12 @@ TEST(Icp, SystemAtTruePoseHasZeroResidualAndKnownCount) {
 // One pair by hand: a source point 3 m in front of the camera and its model point on a plane facing
 // it, r metres behind. With noise weighting the pair's weight is s² with s = σ_n(1 m) / σ_n(3 m)
 // = 0.001884 / 0.014044, and Huber sees r s instead of r.
-kernel::IcpSystem one_pair(float r, bool weighting, float model_sigma = 0.0f) {
+kernel::IcpSystem one_pair(float r, bool weighting, float model_sigma = 0.0f,
+                           const Eigen::Vector3f& src_normal = Eigen::Vector3f(0, 0, -1)) {
   IcpParams params;
   params.noise_weighting = weighting;
   params.model_sigma_m = model_sigma;
-  Image<Eigen::Vector3f> src_v(1, 1, Eigen::Vector3f(0, 0, 3)), src_n(1, 1, Eigen::Vector3f(0, 0, -1));
+  Image<Eigen::Vector3f> src_v(1, 1, Eigen::Vector3f(0, 0, 3)), src_n(1, 1, src_normal);
   Image<Eigen::Vector3f> mod_v(1, 1, Eigen::Vector3f(0, 0, 3 + r)), mod_n(1, 1, Eigen::Vector3f(0, 0, -1));
   const VertexNormalMaps source{DeviceImage<Eigen::Vector3f>::from_host(src_v, Device::cpu()),
                                 DeviceImage<Eigen::Vector3f>::from_host(src_n, Device::cpu())};
@@ -138,6 +139,28 @@ TEST(Icp, NoiseWeightingScalesAPairByTheSensorNoiseAtItsDepth) {
   // A residual of 5 cm at 3 m is 6.7 mm at the reference noise: still quadratic with weighting.
   EXPECT_NEAR(one_pair(0.05f, true).jtj[11], s * s, 1e-6);
   EXPECT_NEAR(one_pair(0.05f, false).jtj[11], 0.01 / 0.05, 1e-5);
+}
+
+// The tracking state's measure: a pair agrees with the model when |r| <= max(δ, 3 σ_n(z)),
+// 4.2 cm at 3 m, whatever its normals; the solver's inliers pass the normal test instead, whatever
+// their residual within max_distance.
+TEST(Icp, AgreementCountsThePairsTheNoiseExplainsWhateverTheirNormals) {
+  const DepthNoiseModel noise;
+  ASSERT_NEAR(3.0 * noise.sigma(3.0f), 0.0421, 1e-4);
+  const Eigen::Vector3f tilted = Eigen::Vector3f(0, 1, -1).normalized();  // 45°: fails the 30° test
+  for (const bool weighting : {false, true}) {
+    SCOPED_TRACE(weighting ? "noise weighting" : "no weighting");
+    const kernel::IcpSystem close = one_pair(0.03f, weighting), far = one_pair(0.05f, weighting);
+    const kernel::IcpSystem close_tilted = one_pair(0.03f, weighting, 0.0f, tilted);
+    EXPECT_EQ(close.agree, 1.0);
+    EXPECT_EQ(close.inliers, 1.0);
+    EXPECT_EQ(far.agree, 0.0);  // 5 cm > 4.2 cm
+    EXPECT_EQ(far.inliers, 1.0);
+    EXPECT_EQ(close_tilted.agree, 1.0);
+    EXPECT_EQ(close_tilted.inliers, 0.0);
+    EXPECT_EQ(close_tilted.valid, 1.0);
+    EXPECT_EQ(one_pair(0.15f, weighting).agree, 0.0);  // beyond max_distance: no pair at all
+  }
 }
 
 // With a model term σ_m the pair's scale is s = sqrt(σ_n(1 m)² + σ_m²) / sqrt(σ_n(3 m)² + σ_m²):
@@ -186,6 +209,7 @@ std::vector<double> reduced_system(const Device& device, const IcpParams& params
     out.push_back(sys.r2_ref);  // the ORB prior's σ (noise weighting, on by default)
     out.push_back(sys.inliers);
     out.push_back(sys.valid);
+    out.push_back(sys.agree);
   }
   return out;
 }
@@ -204,9 +228,10 @@ TEST(Icp, ReducedSystemWithAModelTermDeviceParity) {
 
 TEST(Icp, ReducedSystemDeviceParity) {
   const std::vector<double> cpu = test::expect_device_parity<double>(default_system, 1e-4, 1e-4);
-  ASSERT_EQ(cpu.size(), 93u);
+  ASSERT_EQ(cpu.size(), 96u);
   EXPECT_GT(cpu[30], 1000.0);  // level 0 has thousands of valid pixels
   EXPECT_GT(cpu[29], 100.0);   // and inliers
+  EXPECT_GT(cpu[31], 100.0);   // and pairs agreeing with the model (the frame is off T_ref: fewer)
   EXPECT_GT(cpu[28], 0.0);     // r2_ref: weighted residuals
   EXPECT_NE(cpu[28], cpu[27]); // scaled to the reference depth's noise, not r2 itself
 }

@@ -34,12 +34,12 @@ TEST(TrackingMode, UnknownModeNamesTheTextAndTheChoices) {
 TEST(TrackingParams, DefaultsAreValidAndBadFieldsAreNamed) {
   EXPECT_NO_THROW(TrackingParams{}.validate());
   TrackingParams p;
-  p.icp.min_inlier_ratio = 0.9f;  // above ok_inlier_ratio
+  p.icp.min_agreement = 0.9f;  // above ok_agreement
   try {
     p.validate();
     FAIL() << "no exception";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("inlier ratios"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("icp.min_agreement"), std::string::npos) << e.what();
   }
   TrackingParams q;
   q.preprocess.levels = 4;
