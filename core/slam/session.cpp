@@ -149,9 +149,9 @@ const SessionConfig& Session::config() const { return impl_->config; }
 // --- helpers ----------------------------------------------------------------------------------------
 
 RaycastResult Session::Impl::locked_raycast(const Intrinsics& K_, const Eigen::Isometry3f& T_wc,
-                                            RaycastOutputs outputs) const {
+                                            RaycastOutputs outputs, Reader who) const {
   const std::vector<int32_t> ids = remap_copy();
-  return read_view(K_, T_wc, [&] { return raycast(volume, K_, T_wc, ids, outputs); });
+  return read_view(K_, T_wc, [&] { return raycast(volume, K_, T_wc, ids, outputs); }, who);
 }
 
 // C_r at the ICP pose for the tracking mask (§4.1.2): pass 3 over the plane-id map only, each

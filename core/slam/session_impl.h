@@ -89,23 +89,31 @@ struct Session::Impl {
   void schedule_mapping(FrameReport& report);
   void thin_queue();
   MappingContext mapping_context();
+  // Who reads a streaming TSDF (read_view below): the session itself, or a client's query.
+  enum class Reader { Session, Client };
   RaycastResult locked_raycast(const Intrinsics& K, const Eigen::Isometry3f& T_wc,
-                               RaycastOutputs outputs = RaycastOutputs::all()) const;
+                               RaycastOutputs outputs = RaycastOutputs::all(), Reader who = Reader::Session) const;
   // Streaming (tsdf.stream_radius; docs/tsdf.md "Streaming in a session"). Runs read() under the
   // volume lock with every block a camera K at T_wc may read resident (ViewFrustum). The lock is
   // shared when they are (always without streaming); else it is taken alone, the streamed-out
   // ones come back for read() and go out again after it, so a read leaves the volume's residency
-  // and its pool's size as it found them. Should read() throw, they stay until the next frame
-  // streams out.
+  // as it found it. Should read() throw, they stay until the next frame streams out.
+  //
+  // Who reads decides what happens to the pool's size: a session's own reads (tracking,
+  // identification, mapping keyframes) come back every few frames, so the room they grew is kept
+  // (the pool holds what the session's work needs, and regrowing it each time would copy it each
+  // time); a client's read (render, mesh) gives back the room it grew, so no request can enlarge the
+  // session's device memory for good.
   template <class Read>
-  auto read_view(const Intrinsics& K_view, const Eigen::Isometry3f& T_wc, Read&& read) const {
+  auto read_view(const Intrinsics& K_view, const Eigen::Isometry3f& T_wc, Read&& read,
+                 Reader who = Reader::Session) const {
     const ViewFrustum frustum(K_view, T_wc, volume.params());
-    return read_with(read, [&](const Eigen::Vector3i& b) { return frustum.may_read(b); });
+    return read_with(read, [&](const Eigen::Vector3i& b) { return frustum.may_read(b); }, who);
   }
   // The same for meshing the listed blocks: they and the blocks whose voxels their cubes read
   // (the +x, +y, +z neighbours) resident.
   template <class Read>
-  auto read_blocks(std::span<const Eigen::Vector3i> blocks, Read&& read) const {
+  auto read_blocks(std::span<const Eigen::Vector3i> blocks, Read&& read, Reader who) const {
     std::vector<uint64_t> needed;
     needed.reserve(blocks.size() * 8);
     for (const Eigen::Vector3i& b : blocks)
@@ -116,10 +124,10 @@ struct Session::Impl {
     std::sort(needed.begin(), needed.end());
     return read_with(read, [&](const Eigen::Vector3i& b) {
       return std::binary_search(needed.begin(), needed.end(), block_key(b.x(), b.y(), b.z()));
-    });
+    }, who);
   }
   template <class Read, class Needs>
-  auto read_with(Read& read, const Needs& needs) const {
+  auto read_with(Read& read, const Needs& needs, Reader who) const {
     {
       std::shared_lock lock(volume_mutex);
       if (volume.num_host_blocks() == 0 || volume.host_blocks_where(needs).empty()) return read();
@@ -130,7 +138,7 @@ struct Session::Impl {
     volume.stream_in(back);
     auto result = read();
     volume.stream_out(back);
-    volume.shrink_pool(pool);  // the device memory too, as found (a far render must not grow it for good)
+    if (who == Reader::Client) volume.shrink_pool(pool);  // the device memory too, as found
     return result;
   }
   // C_r for the tracking mask, exact where its mean RGB stays <= stop_mean (the mask's threshold)

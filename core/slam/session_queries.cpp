@@ -11,7 +11,7 @@ SessionView Session::render(const Intrinsics& K, const Eigen::Isometry3f& T_wc) 
   if (!K.valid() || K.width > 8192 || K.height > 8192)
     throw std::invalid_argument("render: bad intrinsics " + K.to_string());
   const Impl& s = *impl_;
-  const RaycastResult rc = s.locked_raycast(K, T_wc);  // pass 1
+  const RaycastResult rc = s.locked_raycast(K, T_wc, RaycastOutputs::all(), Impl::Reader::Client);  // pass 1
   RenderOutputs out;
   s.mapper.render(RenderCamera{K, T_wc}, rc, out);     // passes 2 and 3 on the published snapshot
   SessionView v;
@@ -60,7 +60,7 @@ Session::ChangedBlocks Session::changed_blocks(uint64_t since) const {
 TriangleMesh Session::mesh_of_blocks(const std::vector<Eigen::Vector3i>& blocks) const {
   const Impl& s = *impl_;
   const std::vector<int32_t> remap = s.remap_copy();
-  return s.read_blocks(blocks, [&] { return extract_mesh(s.volume, blocks, remap); });
+  return s.read_blocks(blocks, [&] { return extract_mesh(s.volume, blocks, remap); }, Impl::Reader::Client);
 }
 
 GaussianHost Session::base_gaussians() const { return impl_->mapper.base_host(); }
