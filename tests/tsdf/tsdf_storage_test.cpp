@@ -83,16 +83,29 @@ TEST(TsdfStorage, AllocationFindsExactlyTheBlocksOnTheRaysWithoutLosingAny) {
   }
 }
 
+// A sphere fused from around it on `device`, with its voxels and a novel view's raycast depth.
+struct FusedSphere {
+  TsdfVolume volume;
+  std::vector<float> voxels;
+  DepthImage depth;
+};
+const Eigen::Vector3f kSphereCentre(0, 0, 0);
+const Eigen::Isometry3f kNovel = test::look_at({0.5f, 0.4f, -0.6f}, kSphereCentre);
+FusedSphere fused_sphere(const Device& device) {
+  TsdfVolume v(params(), device);
+  test::fuse_scene(v, test::sphere_scene(kSphereCentre, 0.25f), kK, test::cameras_around(kSphereCentre, 0.9f));
+  std::vector<float> voxels = test::flatten_voxels(v);
+  DepthImage depth = raycast(v, kK, kNovel).depth.to_host();
+  return {std::move(v), std::move(voxels), std::move(depth)};
+}
+
 TEST(TsdfStorage, StreamingOutAndBackInIsExact) {
-  const Eigen::Vector3f c(0, 0, 0);
-  const test::Scene scene = test::sphere_scene(c, 0.25f);
-  const auto novel = test::look_at({0.5f, 0.4f, -0.6f}, c);
   for (const Device& device : available_devices()) {
     SCOPED_TRACE(device.to_string());
-    TsdfVolume v(params(), device);
-    test::fuse_scene(v, scene, kK, test::cameras_around(c, 0.9f));
-    const auto before = test::flatten_voxels(v);
-    const auto depth_before = raycast(v, kK, novel).depth.to_host();
+    FusedSphere fs = fused_sphere(device);
+    TsdfVolume& v = fs.volume;
+    const auto& before = fs.voxels;
+    const auto& depth_before = fs.depth;
     const int64_t total = v.num_blocks();
     const MemoryUsage m0 = v.memory();
     EXPECT_EQ(m0.host_bytes, 0u);
@@ -110,7 +123,7 @@ TEST(TsdfStorage, StreamingOutAndBackInIsExact) {
     EXPECT_EQ(v.num_host_blocks(), 0);
     EXPECT_EQ(v.num_blocks(), total);
     EXPECT_EQ(test::flatten_voxels(v), before);
-    const auto depth_after = raycast(v, kK, novel).depth.to_host();
+    const auto depth_after = raycast(v, kK, kNovel).depth.to_host();
     EXPECT_TRUE(std::equal(depth_after.pixels().begin(), depth_after.pixels().end(), depth_before.pixels().begin()));
   }
 }
@@ -118,15 +131,14 @@ TEST(TsdfStorage, StreamingOutAndBackInIsExact) {
 // shrink_pool gives back the room beyond the resident blocks (never below them) and changes no
 // voxel; the pool grows again when blocks come back.
 TEST(TsdfStorage, ShrinkingThePoolKeepsTheResidentBlocks) {
-  const Eigen::Vector3f c(0, 0, 0);
+  const Eigen::Vector3f c = kSphereCentre;
   const test::Scene scene = test::sphere_scene(c, 0.25f);
-  const auto novel = test::look_at({0.5f, 0.4f, -0.6f}, c);
   for (const Device& device : available_devices()) {
     SCOPED_TRACE(device.to_string());
-    TsdfVolume v(params(), device);
-    test::fuse_scene(v, scene, kK, test::cameras_around(c, 0.9f));
-    const auto before = test::flatten_voxels(v);
-    const auto depth_before = raycast(v, kK, novel).depth.to_host();
+    FusedSphere fs = fused_sphere(device);
+    TsdfVolume& v = fs.volume;
+    const auto& before = fs.voxels;
+    const auto& depth_before = fs.depth;
     const int64_t total = v.num_blocks();
     ASSERT_GE(v.pool_capacity(), total);
     v.stream_out({0.3f, 0, 0}, 0.3f);
@@ -141,7 +153,7 @@ TEST(TsdfStorage, ShrinkingThePoolKeepsTheResidentBlocks) {
     EXPECT_EQ(v.stream_in_all(), total - resident);
     EXPECT_GE(v.pool_capacity(), total);
     EXPECT_EQ(test::flatten_voxels(v), before);
-    const auto depth_after = raycast(v, kK, novel).depth.to_host();
+    const auto depth_after = raycast(v, kK, kNovel).depth.to_host();
     EXPECT_TRUE(std::equal(depth_after.pixels().begin(), depth_after.pixels().end(), depth_before.pixels().begin()));
     // Fusion after a shrink: new blocks take the zeroed free slots as before.
     v.stream_out({0.3f, 0, 0}, 0.3f);
