@@ -264,21 +264,31 @@ void TsdfVolume::insert_blocks(std::span<const BlockData> blocks) {
   insert_block_ptrs(ptrs);
 }
 
-void TsdfVolume::insert_host_blocks(std::vector<BlockData> blocks) {
-  if (blocks.empty()) return;
+std::vector<uint64_t> TsdfVolume::keys_of_new_blocks(std::span<const BlockData* const> blocks, const char* who) const {
   const auto existing = download_prefix(block_keys_, num_blocks_);
   std::vector<uint64_t> present(existing);
   std::sort(present.begin(), present.end());
   std::vector<uint64_t> keys;
   keys.reserve(blocks.size());
-  for (const BlockData& b : blocks) {
-    if (!block_in_range(b.coord.x(), b.coord.y(), b.coord.z()) || b.voxels.size() != size_t(kBlockVoxels))
-      throw std::invalid_argument("TsdfVolume::insert_host_blocks: block out of range or not 512 voxels");
-    const uint64_t key = block_key(b.coord.x(), b.coord.y(), b.coord.z());
-    if (std::binary_search(present.begin(), present.end(), key) || host_blocks_.count(key))
-      throw std::invalid_argument("TsdfVolume::insert_host_blocks: block already present");
+  for (const BlockData* b : blocks) {
+    if (!block_in_range(b->coord.x(), b->coord.y(), b->coord.z()) || b->voxels.size() != size_t(kBlockVoxels))
+      throw std::invalid_argument(std::string("TsdfVolume::") + who + ": block out of range or not 512 voxels");
+    const uint64_t key = block_key(b->coord.x(), b->coord.y(), b->coord.z());
+    if (std::binary_search(present.begin(), present.end(), key))
+      throw std::invalid_argument(std::string("TsdfVolume::") + who + ": block already present");
     keys.push_back(key);
   }
+  return keys;
+}
+
+void TsdfVolume::insert_host_blocks(std::vector<BlockData> blocks) {
+  if (blocks.empty()) return;
+  std::vector<const BlockData*> ptrs;
+  ptrs.reserve(blocks.size());
+  for (const BlockData& b : blocks) ptrs.push_back(&b);
+  const std::vector<uint64_t> keys = keys_of_new_blocks(ptrs, "insert_host_blocks");
+  for (uint64_t key : keys)
+    if (host_blocks_.count(key)) throw std::invalid_argument("TsdfVolume::insert_host_blocks: block already present");
   std::vector<uint64_t> sorted(keys);
   std::sort(sorted.begin(), sorted.end());
   if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
@@ -288,20 +298,11 @@ void TsdfVolume::insert_host_blocks(std::vector<BlockData> blocks) {
 
 void TsdfVolume::insert_block_ptrs(std::span<const BlockData* const> blocks) {
   if (blocks.empty()) return;
-  const auto existing = download_prefix(block_keys_, num_blocks_);
-  std::vector<uint64_t> present(existing);
-  std::sort(present.begin(), present.end());
   const int64_t n = int64_t(blocks.size()), first = num_blocks_;
-  std::vector<uint64_t> keys, versions;
-  for (const BlockData* b : blocks) {
-    if (!block_in_range(b->coord.x(), b->coord.y(), b->coord.z()) || b->voxels.size() != size_t(kBlockVoxels))
-      throw std::invalid_argument("TsdfVolume::insert_blocks: block out of range or not 512 voxels");
-    const uint64_t key = block_key(b->coord.x(), b->coord.y(), b->coord.z());
-    if (std::binary_search(present.begin(), present.end(), key))
-      throw std::invalid_argument("TsdfVolume::insert_blocks: block already present");
-    keys.push_back(key);
-    versions.push_back(b->version);
-  }
+  const std::vector<uint64_t> keys = keys_of_new_blocks(blocks, "insert_blocks");
+  std::vector<uint64_t> versions;
+  versions.reserve(blocks.size());
+  for (const BlockData* b : blocks) versions.push_back(b->version);
   ensure_pool(first + n);
   mem::copy(block_keys_.data() + first, device_, keys.data(), Device::cpu(), keys.size() * sizeof(uint64_t));
   mem::copy(block_versions_.data() + first, device_, versions.data(), Device::cpu(), versions.size() * sizeof(uint64_t));

@@ -144,6 +144,9 @@ class TsdfVolume {
   void upload_blocks(std::span<const int32_t> slots, Source&& source);
   void move_blocks(std::span<const int32_t> from, std::span<const int32_t> to);  // slot from[j] -> to[j]
   void insert_block_ptrs(std::span<const BlockData* const> blocks);  // insert_blocks
+  // Their keys, after checking each is in range, of 512 voxels and not resident (else
+  // std::invalid_argument naming `who`).
+  std::vector<uint64_t> keys_of_new_blocks(std::span<const BlockData* const> blocks, const char* who) const;
   // Moves the resident blocks whose key satisfies leave(key) to host memory.
   template <class Leave>
   int64_t stream_out_where(Leave leave);
