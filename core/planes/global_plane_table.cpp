@@ -11,6 +11,53 @@
 
 namespace rrg {
 
+namespace {
+
+// One local plane of the frame being associated, with the plane fitted to its points.
+struct FittedObservation {
+  const LocalObservation* obs = nullptr;
+  PlaneMoments moments;
+  PlaneFit fit;
+
+  explicit FittedObservation(const LocalObservation& o) : obs(&o) {
+    for (const Eigen::Vector3f& p : o.points) moments.add(p);
+    fit = fit_plane(moments);
+  }
+};
+
+// Whether two local planes of one frame are one surface (the rule "one frame, one surface per
+// instance"): one plane explains both point sets as well as their own planes do.
+//  - Offset: the plane fitted to their union has each piece's centroid within that piece's
+//    coplanarity tolerance (same_plane_distance, the segmenter's step 3).
+//  - Tilt: the union's RMS residual is within the segmenter's planarity bound (planar_rms, pooled
+//    over the points) and within twice the pieces' own RMS (pooled; at least the segmenter's
+//    distance scale same_plane_distance / 3, so noise-free pieces are not held to zero). Two parallel
+//    layers side by side, each with residual σ, tilt the union's plane until both centroids lie on it,
+//    and leave a residual variance σ² + δ²/16 (δ the offset): twice σ is exceeded once δ > √48 σ
+//    ≈ 7 σ (a chair's seat 6 cm over the floor beside it, σ 5.6 mm: 3.0 times).
+// Each piece's own normal is not compared. A small piece's fit tilts by 5–15° at 4–5 m (strips of
+// a wall between shelves and posters, whose own RMS the pixels of the things before them raise),
+// and over the metres between two pieces that tilt exceeds any noise bound, while the union's fit,
+// spanning both, is well determined: such pieces have 1.2–1.9 times their own RMS about it.
+bool same_surface(const FittedObservation& a, const FittedObservation& b) {
+  if (!a.fit.valid || !b.fit.valid) return false;
+  PlaneMoments joint = a.moments;
+  joint.merge(b.moments);
+  const PlaneFit fit = fit_plane(joint);
+  if (!fit.valid) return false;
+  const double na = double(a.moments.count()), nb = double(b.moments.count());
+  const auto pooled = [&](double va, double vb) { return (na * va + nb * vb) / (na + nb); };
+  const auto sq = [](float x) { return double(x) * double(x); };
+  const double noise_bound = pooled(sq(a.obs->planar_rms), sq(b.obs->planar_rms));
+  const double own = pooled(std::max(double(a.fit.mse), sq(a.obs->same_plane_distance / 3.0f)),
+                            std::max(double(b.fit.mse), sq(b.obs->same_plane_distance / 3.0f)));
+  return std::abs(fit.plane.signed_distance(a.fit.centroid)) < a.obs->same_plane_distance &&
+         std::abs(fit.plane.signed_distance(b.fit.centroid)) < b.obs->same_plane_distance &&
+         double(fit.mse) <= noise_bound && double(fit.mse) <= 4.0 * own;
+}
+
+}  // namespace
+
 void GlobalPlaneParams::validate() const {
   auto need = [](bool ok, const char* what) {
     if (!ok) throw std::invalid_argument(std::string("GlobalPlaneParams: ") + what);
@@ -47,6 +94,7 @@ std::vector<LocalObservation> GlobalPlaneTable::observe(const PlaneSegmentation&
     out[i].plane = seg.planes[i].plane.transformed(T_wc);
     out[i].centroid = T_wc * seg.planes[i].centroid;
     out[i].same_plane_distance = seg.planes[i].same_plane_distance;
+    out[i].planar_rms = seg.planes[i].planar_rms;
     out[i].points.reserve(size_t(seg.planes[i].pixels / (params_.point_stride * params_.point_stride) + 16));
   }
   const int s = params_.point_stride;
@@ -66,19 +114,6 @@ float GlobalPlaneTable::cos_max_normal_angle() const {
 bool GlobalPlaneTable::geometric_match(const Plane& a, const Eigen::Vector3f& centroid_b) const {
   // Only plane a's normal is compared here; callers pass both orders where symmetry matters.
   return std::abs(a.signed_distance(centroid_b)) <= params_.max_distance;
-}
-
-// The segmenter's coplanarity test (plane_segmentation.cpp, step 3) on two planes of one frame, made
-// one-sided for planes that need not touch: normals within the filter's angle, and the centroid of the
-// plane with fewer points within its same_plane_distance of the plane with more (a small piece's fit
-// may tilt by degrees, which over a metre between the pieces would exceed any noise bound).
-bool GlobalPlaneTable::same_surface(const LocalObservation& a, const LocalObservation& b) const {
-  const float cos_max = cos_max_normal_angle();
-  const bool a_larger = a.points.size() >= b.points.size();
-  const LocalObservation& large = a_larger ? a : b;
-  const LocalObservation& small = a_larger ? b : a;
-  return a.plane.n.dot(b.plane.n) >= cos_max &&
-         std::abs(large.plane.signed_distance(small.centroid)) < small.same_plane_distance;
 }
 
 std::vector<CandidateScore> GlobalPlaneTable::score(const LocalObservation& obs, int64_t frame) const {
@@ -133,14 +168,18 @@ FrameAssociation GlobalPlaneTable::associate(std::span<const LocalObservation> o
   for (const auto& o : observations) max_local = std::max(max_local, o.local_id);
   out.local_to_global.assign(size_t(max_local) + 1, 0);
   std::vector<int> touched;
-  std::vector<std::pair<int, const LocalObservation*>> claims;  // (instance, a local plane of this frame in it)
+  std::vector<std::pair<int, const FittedObservation*>> claims;  // (instance, a local plane of this frame in it)
+  std::vector<FittedObservation> fitted;
+  fitted.reserve(observations.size());
+  for (const LocalObservation& obs : observations) fitted.emplace_back(obs);
   // An instance already holding a local plane of this frame that is a different surface.
-  const auto taken = [&](int id, const LocalObservation& obs) {
+  const auto taken = [&](int id, const FittedObservation& f) {
     for (const auto& [g, other] : claims)
-      if (g == id && !same_surface(*other, obs)) return true;
+      if (g == id && !same_surface(*other, f)) return true;
     return false;
   };
-  for (const LocalObservation& obs : observations) {
+  for (const FittedObservation& f : fitted) {
+    const LocalObservation& obs = *f.obs;
     if (obs.points.size() < 3) continue;
     const std::vector<CandidateScore> scores = score(obs, frame);
     // Candidates the observation lies on within its noise come before those only within the
@@ -159,7 +198,7 @@ FrameAssociation GlobalPlaneTable::associate(std::span<const LocalObservation> o
     std::vector<int> blocked;  // matching instances held by a different surface of this frame
     for (const CandidateScore& s : scores) {
       if (!s.matched) continue;
-      if (taken(s.global_id, obs)) {
+      if (taken(s.global_id, f)) {
         blocked.push_back(s.global_id);
         continue;
       }
@@ -170,7 +209,7 @@ FrameAssociation GlobalPlaneTable::associate(std::span<const LocalObservation> o
     // this frame (the same surface by the segmenter's test) that was kept off it too joins that piece.
     if (!best && !blocked.empty())
       for (const auto& [g, other] : claims)
-        if (same_surface(*other, obs) &&
+        if (same_surface(*other, f) &&
             std::any_of(blocked.begin(), blocked.end(), [&](int b) { return seen_apart(g, b); })) {
           id = g;
           break;
@@ -193,7 +232,7 @@ FrameAssociation GlobalPlaneTable::associate(std::span<const LocalObservation> o
         planes_[size_t(g - 1)].apart.push_back(id);
         planes_[size_t(id - 1)].apart.push_back(g);
       }
-    claims.emplace_back(id, &obs);
+    claims.emplace_back(id, &f);
   }
   merge_pass(touched, out);
   for (int& id : out.local_to_global) id = id > 0 ? canonical(id) : 0;

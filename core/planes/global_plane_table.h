@@ -8,8 +8,9 @@
 //    last `recent_frames` frames; among matching candidates the highest overlap wins (ours: those
 //    whose plane the observation's centroid lies on within LocalPlane::same_plane_distance first);
 //    no match creates a new instance;
-//  - one frame, one surface per instance (ours): two local planes of one frame that the segmenter
-//    keeps apart as different surfaces (LocalPlane::same_plane_distance) do not share an instance;
+//  - one frame, one surface per instance (ours): two local planes of one frame that no one plane
+//    explains within the segmenter's tolerances (LocalPlane::same_plane_distance, planar_rms) do not
+//    share an instance;
 //    the larger keeps it, the other takes its next match or a new instance, and the two instances
 //    are recorded as seen apart, so the merge pass never joins them (a mirror frame's bar 3.5 cm in
 //    front of the mirror, a bookshelf's back 2.5 cm in front of its wall: both within the 0.1 m filter);
@@ -69,6 +70,7 @@ struct LocalObservation {
   Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
   std::vector<Eigen::Vector3f> points; // world frame (subsampled pixels)
   float same_plane_distance = 0.01f;   // LocalPlane::same_plane_distance
+  float planar_rms = 0.01f;            // LocalPlane::planar_rms
 };
 
 // How one local plane compared with one candidate (for logs and tests).
@@ -115,7 +117,6 @@ class GlobalPlaneTable {
   friend struct PlaneStateIo;  // snapshots (plane_state_io.h)
   float cos_max_normal_angle() const;  // cos of the geometric filter's normal angle
   bool geometric_match(const Plane& a, const Eigen::Vector3f& centroid_b) const;
-  bool same_surface(const LocalObservation& a, const LocalObservation& b) const;
   void absorb(GlobalPlane& into, const LocalObservation& obs, int64_t frame);
   int create(const LocalObservation& obs, int64_t frame);
   void merge_pass(std::span<const int> touched, FrameAssociation& out);

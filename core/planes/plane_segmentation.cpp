@@ -318,6 +318,7 @@ PlaneSegmentation segment_planes(const DepthImage& depth, const Intrinsics& K, c
     lp.pixels = moments[size_t(r)].count();
     lp.rms = std::sqrt(f.mse);
     lp.same_plane_distance = params.merge_tolerance(f.centroid.z());
+    lp.planar_rms = params.planar_rms(f.centroid.z());
     new_id[size_t(r)] = lp.id;
     out.planes.push_back(lp);
   }

@@ -35,6 +35,9 @@ struct LocalPlane {
   // The segmenter's coplanarity tolerance at this plane's depth, max(merge_distance, 3 σ(z)): two
   // planes of one depth map are one surface only when each centroid lies this close to the other.
   float same_plane_distance = 0.01f;
+  // The segmenter's planarity bound at this plane's depth, max(σ(z), 2 σ_n(z)): the RMS residual a
+  // planar patch of the sensor's noise stays under (a cell's planarity test).
+  float planar_rms = 0.01f;
 };
 
 struct PlaneSegmentation {

@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <random>
 #include <vector>
 
 namespace rrg {
@@ -23,6 +25,28 @@ LocalObservation patch(int local_id, float x0, float x1, float y0, float y1, flo
       sum += o.points.back();
     }
   o.centroid = sum / float(o.points.size());
+  return o;
+}
+
+// Points every 1 cm over [x0, x1] x [y0, y1] at height z(x) plus uniform noise of standard deviation
+// sigma (fixed seed), with the plane and centroid the segmenter would report: fitted to the points.
+template <class Height>
+LocalObservation noisy_patch(int local_id, float x0, float x1, float y0, float y1, Height z, float sigma, uint32_t seed) {
+  std::mt19937 rng(seed);
+  const float half_width = sigma * std::sqrt(3.0f);
+  LocalObservation o;
+  o.local_id = local_id;
+  PlaneMoments m;
+  const int nx = int(std::lround((x1 - x0) / 0.01f)), ny = int(std::lround((y1 - y0) / 0.01f));
+  for (int i = 0; i <= nx; ++i)
+    for (int j = 0; j <= ny; ++j) {
+      const float x = x0 + 0.01f * float(i), u = float(rng()) / 4294967296.0f;
+      o.points.emplace_back(x, y0 + 0.01f * float(j), z(x) + half_width * (2.0f * u - 1.0f));
+      m.add(o.points.back());
+    }
+  const PlaneFit fit = fit_plane(m, Eigen::Vector3f(0, 0, 10));  // seen from above
+  o.plane = fit.plane;
+  o.centroid = fit.centroid;
   return o;
 }
 
@@ -168,16 +192,17 @@ TEST(GlobalPlaneTable, MergePassJoinsInstancesThatTurnOutToBeOnePlane) {
 // other, and inside each other's dilated footprints, so by overlap alone the bar takes the mirror's
 // instance, and the merge pass would join a bar instance to the mirror's.
 TEST(GlobalPlaneTable, OneFrameKeepsDifferentSurfacesInDifferentInstances) {
-  const auto frame_of = [](float same_plane_distance) {
+  const auto frame_of = [](float same_plane_distance, float planar_rms) {
     LocalObservation mirror = patch(1, 0, 1, 0, 1), bar = patch(2, 1.0f, 1.08f, 0, 1, 0.035f);
     mirror.same_plane_distance = bar.same_plane_distance = same_plane_distance;
+    mirror.planar_rms = bar.planar_rms = planar_rms;
     return std::vector<LocalObservation>{mirror, bar};
   };
   {
     GlobalPlaneTable t;
     associate_one(t, patch(1, 0, 1, 0, 1), 0);  // the mirror alone first: instance 1
     // Seen together at ~2 m, where the segmenter's coplanarity tolerance is 1.2 cm: two surfaces.
-    const auto both = frame_of(0.012f);
+    const auto both = frame_of(0.012f, 0.012f);
     const FrameAssociation a = t.associate(both, 10);
     EXPECT_EQ(a.local_to_global[1], 1);
     EXPECT_EQ(a.local_to_global[2], 2);
@@ -195,10 +220,11 @@ TEST(GlobalPlaneTable, OneFrameKeepsDifferentSurfacesInDifferentInstances) {
     EXPECT_EQ(t.live_ids(), (std::vector<int>{1, 2}));
   }
   {
-    // At ~4 m the tolerance (3 σ = 4.8 cm) covers 3.5 cm: one surface, as before the rule.
+    // At ~4 m the tolerance (3 σ = 4.8 cm, planarity bound 2 σ_n = 5.2 cm) covers 3.5 cm: one
+    // surface, as before the rule.
     GlobalPlaneTable t;
     associate_one(t, patch(1, 0, 1, 0, 1), 0);
-    const auto both = frame_of(0.048f);
+    const auto both = frame_of(0.048f, 0.052f);
     const FrameAssociation a = t.associate(both, 10);
     EXPECT_EQ(a.local_to_global[1], 1);
     EXPECT_EQ(a.local_to_global[2], 1);
@@ -231,6 +257,58 @@ TEST(GlobalPlaneTable, PiecesOfOneSurfaceShareTheInstance) {
   EXPECT_TRUE(u.seen_apart(2, 4));
   EXPECT_TRUE(u.seen_apart(4, 3));
   EXPECT_FALSE(u.seen_apart(1, 4));
+}
+
+// Two strips of one wall 12 cm wide, 2 m apart, seen at ~4 m (noise σ 1.5 cm, coplanarity
+// tolerance 4.4 cm, planarity bound 5.2 cm). Each has in its outer column the edge of something 3 cm
+// before the wall (the segmenter takes pixels within 2.5 σ_n of a plane), which tilts its fit by
+// ~5°: extrapolated over the 2 m to the other strip, each strip's plane misses it by ~20 cm. The
+// plane of their union lies on both: one surface, one instance, nothing recorded as seen apart.
+TEST(GlobalPlaneTable, PiecesOfAFarWallWhoseFitsTiltShareTheInstance) {
+  GlobalPlaneTable t;
+  associate_one(t, patch(1, 0, 2.12f, 0, 1), 0);                   // 1: the wall, z = 0
+  const auto edge_at = [](float x_edge) { return [=](float x) { return std::abs(x - x_edge) < 0.005f ? 0.03f : 0.0f; }; };
+  LocalObservation a = noisy_patch(1, 0.0f, 0.12f, 0, 1, edge_at(0.12f), 0.015f, 1);
+  LocalObservation b = noisy_patch(2, 2.0f, 2.12f, 0, 1, edge_at(2.0f), 0.015f, 2);
+  for (LocalObservation* o : {&a, &b}) {
+    o->same_plane_distance = 0.044f;
+    o->planar_rms = 0.052f;
+  }
+  ASSERT_GT(std::abs(a.plane.signed_distance(b.centroid)), 0.15f);  // the premise: tilted fits
+  ASSERT_GT(std::abs(b.plane.signed_distance(a.centroid)), 0.15f);
+  const LocalObservation frame[] = {a, b};
+  const FrameAssociation f = t.associate(frame, 10);
+  EXPECT_EQ(f.local_to_global[1], 1);
+  EXPECT_EQ(f.local_to_global[2], 1);
+  EXPECT_EQ(f.created, 0);
+  EXPECT_EQ(t.live_ids(), (std::vector<int>{1}));
+}
+
+// A chair's seat 6 cm over the floor, beside a floor piece of about its size, both with noise σ 5 mm
+// (~2.5 m; coplanarity tolerance 1.4 cm, planarity bound 1.7 cm). The plane of their union tilts
+// until it passes through both centroids and stays within the planarity bound, so offset and noise
+// alone would call them one surface; its residual, 3 times the pieces' own, does not.
+TEST(GlobalPlaneTable, ALayerBesideAnotherIsAnotherSurfaceThoughTheirUnionPassesThroughBoth) {
+  GlobalPlaneTable t;
+  associate_one(t, patch(1, 0.4f, 1.0f, 0, 0.5f), 0);              // 1: the floor, z = 0
+  LocalObservation floor = noisy_patch(1, 0.4f, 1.0f, 0, 0.5f, [](float) { return 0.0f; }, 0.005f, 3);
+  LocalObservation seat = noisy_patch(2, 1.02f, 1.52f, 0, 0.5f, [](float) { return 0.06f; }, 0.005f, 4);
+  for (LocalObservation* o : {&floor, &seat}) {
+    o->same_plane_distance = 0.014f;
+    o->planar_rms = 0.017f;
+  }
+  PlaneMoments both;
+  for (const LocalObservation* o : {&floor, &seat})
+    for (const Eigen::Vector3f& p : o->points) both.add(p);
+  const PlaneFit joint = fit_plane(both);
+  ASSERT_LT(std::abs(joint.plane.signed_distance(floor.centroid)), floor.same_plane_distance);  // the premise
+  ASSERT_LT(std::abs(joint.plane.signed_distance(seat.centroid)), seat.same_plane_distance);
+  ASSERT_LT(std::sqrt(joint.mse), floor.planar_rms);
+  const LocalObservation frame[] = {floor, seat};
+  const FrameAssociation f = t.associate(frame, 10);
+  EXPECT_EQ(f.local_to_global[1], 1);
+  EXPECT_EQ(f.local_to_global[2], 2);
+  EXPECT_TRUE(t.seen_apart(1, 2));
 }
 
 // Among matching instances, those the observation lies on within its noise come first: a piece of
