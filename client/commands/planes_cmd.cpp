@@ -149,6 +149,8 @@ void run_eval(const EvalOptions& o) {
                       {"fuse_ms", r.fuse_ms}, {"raycast_ms", r.raycast_ms}, {"filled_pixels", r.filled_pixels}, {"fill_ms", r.fill_ms}, {"cues", nlohmann::json::array()}};
   for (const auto& [g, h] : r.ids.unstable)
     for (const auto& [id, n] : h) j["id_stability"]["unstable"][std::to_string(g)][std::to_string(id)] = n;
+  for (const auto& [g, held] : r.ids.on_other_id)
+    j["id_stability"]["on_other_id"][std::to_string(g)] = {{"id", held.first}, {"mostly_gt", held.second}};
   for (const auto& c : r.cues)
     j["cues"].push_back({{"semantics", c.semantics}, {"precision", c.reflective.precision()}, {"recall", c.reflective.recall()},
                          {"accepted", c.reflective.accepted}, {"accepted_correct", c.reflective.accepted_correct},
@@ -187,6 +189,8 @@ void run_eval(const EvalOptions& o) {
     }
     std::printf("  unstable GT plane %d: global id:frames%s\n", g, ids.c_str());
   }
+  for (const auto& [g, held] : r.ids.on_other_id)
+    std::printf("  stable on another plane's id: GT plane %d keeps id %d (mostly GT %d)\n", g, held.first, held.second);
   std::printf("variance the input shows on reflective GT planes (identification frames, ground truth; "
               "verifiable: > %.3g of the points above %.3g):\n", e.params.area_threshold, e.params.variance_threshold);
   for (const auto& ob : r.observed)

@@ -13,33 +13,47 @@ namespace rrg {
 
 namespace {
 
-// One local plane of the frame being associated, with the plane fitted to its points.
-struct FittedObservation {
-  const LocalObservation* obs = nullptr;
+// Points of one surface as far as the tests below need them: their moments, the plane fitted to
+// them, and the segmenter's tolerances at the distance they were seen from.
+struct SurfaceSample {
   PlaneMoments moments;
   PlaneFit fit;
+  float same_plane_distance = 0.01f;  // LocalPlane::same_plane_distance
+  float planar_rms = 0.0f;            // LocalPlane::planar_rms; 0 = no planarity bound
 
-  explicit FittedObservation(const LocalObservation& o) : obs(&o) {
-    for (const Eigen::Vector3f& p : o.points) moments.add(p);
-    fit = fit_plane(moments);
-  }
+  SurfaceSample(const PlaneMoments& m, float same_plane, float planar)
+      : moments(m), fit(fit_plane(m)), same_plane_distance(same_plane), planar_rms(planar) {}
 };
 
-// Whether two local planes of one frame are one surface (the rule "one frame, one surface per
-// instance"): one plane explains both point sets as well as their own planes do.
-//  - Offset: the plane fitted to their union has each piece's centroid within that piece's
+PlaneMoments moments_of(std::span<const Eigen::Vector3f> points) {
+  PlaneMoments m;
+  for (const Eigen::Vector3f& p : points) m.add(p);
+  return m;
+}
+
+// One local plane of the frame being associated, with the plane fitted to its points.
+struct FittedObservation : SurfaceSample {
+  const LocalObservation* obs = nullptr;
+
+  explicit FittedObservation(const LocalObservation& o)
+      : SurfaceSample(moments_of(o.points), o.same_plane_distance, o.planar_rms), obs(&o) {}
+};
+
+// Whether two samples are one surface: one plane explains both point sets as well as their own
+// planes do.
+//  - Offset: the plane fitted to their union has each sample's centroid within that sample's
 //    coplanarity tolerance (same_plane_distance, the segmenter's step 3).
 //  - Tilt: the union's RMS residual is within the segmenter's planarity bound (planar_rms, pooled
-//    over the points) and within twice the pieces' own RMS (pooled; at least the segmenter's
+//    over the points) and within twice the samples' own RMS (pooled; at least the segmenter's
 //    distance scale same_plane_distance / 3, so noise-free pieces are not held to zero). Two parallel
 //    layers side by side, each with residual σ, tilt the union's plane until both centroids lie on it,
 //    and leave a residual variance σ² + δ²/16 (δ the offset): twice σ is exceeded once δ > √48 σ
 //    ≈ 7 σ (a chair's seat 6 cm over the floor beside it, σ 5.6 mm: 3.0 times).
-// Each piece's own normal is not compared. A small piece's fit tilts by 5–15° at 4–5 m (strips of
+// Each sample's own normal is not compared. A small piece's fit tilts by 5–15° at 4–5 m (strips of
 // a wall between shelves and posters, whose own RMS the pixels of the things before them raise),
 // and over the metres between two pieces that tilt exceeds any noise bound, while the union's fit,
 // spanning both, is well determined: such pieces have 1.2–1.9 times their own RMS about it.
-bool same_surface(const FittedObservation& a, const FittedObservation& b) {
+bool same_surface(const SurfaceSample& a, const SurfaceSample& b) {
   if (!a.fit.valid || !b.fit.valid) return false;
   PlaneMoments joint = a.moments;
   joint.merge(b.moments);
@@ -48,12 +62,13 @@ bool same_surface(const FittedObservation& a, const FittedObservation& b) {
   const double na = double(a.moments.count()), nb = double(b.moments.count());
   const auto pooled = [&](double va, double vb) { return (na * va + nb * vb) / (na + nb); };
   const auto sq = [](float x) { return double(x) * double(x); };
-  const double noise_bound = pooled(sq(a.obs->planar_rms), sq(b.obs->planar_rms));
-  const double own = pooled(std::max(double(a.fit.mse), sq(a.obs->same_plane_distance / 3.0f)),
-                            std::max(double(b.fit.mse), sq(b.obs->same_plane_distance / 3.0f)));
-  return std::abs(fit.plane.signed_distance(a.fit.centroid)) < a.obs->same_plane_distance &&
-         std::abs(fit.plane.signed_distance(b.fit.centroid)) < b.obs->same_plane_distance &&
-         double(fit.mse) <= noise_bound && double(fit.mse) <= 4.0 * own;
+  const bool bounded = a.planar_rms > 0 && b.planar_rms > 0;
+  const double noise_bound = pooled(sq(a.planar_rms), sq(b.planar_rms));
+  const double own = pooled(std::max(double(a.fit.mse), sq(a.same_plane_distance / 3.0f)),
+                            std::max(double(b.fit.mse), sq(b.same_plane_distance / 3.0f)));
+  return std::abs(fit.plane.signed_distance(a.fit.centroid)) < a.same_plane_distance &&
+         std::abs(fit.plane.signed_distance(b.fit.centroid)) < b.same_plane_distance &&
+         (!bounded || double(fit.mse) <= noise_bound) && double(fit.mse) <= 4.0 * own;
 }
 
 }  // namespace
@@ -146,6 +161,8 @@ void GlobalPlaneTable::absorb(GlobalPlane& g, const LocalObservation& obs, int64
   g.footprint.add_points(obs.points);
   g.last_seen = std::max(g.last_seen, frame);
   ++g.observations;
+  g.same_plane_distance = g.observations == 1 ? obs.same_plane_distance
+                                              : std::min(g.same_plane_distance, obs.same_plane_distance);
 }
 
 int GlobalPlaneTable::create(const LocalObservation& obs, int64_t frame) {
@@ -169,6 +186,23 @@ FrameAssociation GlobalPlaneTable::associate(std::span<const LocalObservation> o
   out.local_to_global.assign(size_t(max_local) + 1, 0);
   std::vector<int> touched;
   std::vector<std::pair<int, const FittedObservation*>> claims;  // (instance, a local plane of this frame in it)
+  std::vector<std::pair<int, int>> bridged_twice;                // instances to merge after the frame
+  // A local plane that took instance `took` also matched instance `other`: whether it is one surface
+  // with `other` (its accumulated points, held to its closest look's tolerance), and if so whether an
+  // earlier frame recorded the same (then true: merge them); otherwise this frame is recorded.
+  const auto bridges = [&](int took, int other, const SurfaceSample& piece) {
+    GlobalPlane& a = planes_[size_t(canonical(took) - 1)];
+    const GlobalPlane& b = planes_[size_t(canonical(other) - 1)];
+    if (!same_surface(piece, SurfaceSample(b.moments, b.same_plane_distance, 0.0f))) return false;
+    const auto earlier = [&](const GlobalPlane& g, int to) {
+      return std::any_of(g.bridged.begin(), g.bridged.end(),
+                         [&](const auto& e) { return canonical(e.first) == to && e.second < frame; });
+    };
+    if (earlier(a, b.id) || earlier(b, a.id)) return true;
+    if (std::none_of(a.bridged.begin(), a.bridged.end(), [&](const auto& e) { return canonical(e.first) == b.id; }))
+      a.bridged.emplace_back(b.id, frame);
+    return false;
+  };
   std::vector<FittedObservation> fitted;
   fitted.reserve(observations.size());
   for (const LocalObservation& obs : observations) fitted.emplace_back(obs);
@@ -233,7 +267,21 @@ FrameAssociation GlobalPlaneTable::associate(std::span<const LocalObservation> o
         planes_[size_t(id - 1)].apart.push_back(g);
       }
     claims.emplace_back(id, &f);
+    if (!created)
+      for (const CandidateScore& s : scores)
+        if (s.matched && canonical(s.global_id) != canonical(id) && !taken(s.global_id, f) &&
+            !seen_apart(id, s.global_id) && bridges(id, s.global_id, f))
+          bridged_twice.emplace_back(id, s.global_id);
   }
+  // Two frames in which a piece of one instance was one surface with another: one surface.
+  for (const auto& [a, b] : bridged_twice) {
+    const int ra = canonical(a), rb = canonical(b);
+    if (ra == rb || seen_apart(ra, rb)) continue;
+    merge(ra, rb);
+    out.merges.emplace_back(std::min(ra, rb), std::max(ra, rb));
+    spdlog::debug("planes: frame {}: instances {} and {} were bridged by one surface in two frames; merged", frame, ra, rb);
+  }
+  for (int& t : touched) t = canonical(t);
   merge_pass(touched, out);
   for (int& id : out.local_to_global) id = id > 0 ? canonical(id) : 0;
   return out;
@@ -284,8 +332,11 @@ bool GlobalPlaneTable::merge(int a, int b) {
   k.first_seen = std::min(k.first_seen, g.first_seen);
   k.last_seen = std::max(k.last_seen, g.last_seen);
   k.observations += g.observations;
+  k.same_plane_distance = std::min(k.same_plane_distance, g.same_plane_distance);
   k.apart.insert(k.apart.end(), g.apart.begin(), g.apart.end());
   g.apart.clear();
+  k.bridged.insert(k.bridged.end(), g.bridged.begin(), g.bridged.end());
+  g.bridged.clear();
   g.alive = false;
   parent_[size_t(gone)] = kept;
   return true;

@@ -16,7 +16,10 @@
 //    front of the mirror, a bookshelf's back 2.5 cm in front of its wall: both within the 0.1 m filter);
 //  - union-find merges of instances recognised as one physical plane (the lower id absorbs the
 //    higher: moments, plane parameters, footprint and bounding box are unified), and the id remap
-//    table (id -> canonical id) used by TSDF fusion and raycasting.
+//    table (id -> canonical id) used by TSDF fusion and raycasting. Ours: recognised when the smaller
+//    footprint lies > 30 % inside the other, or when in two frames a local plane that took one
+//    instance also matched the other and was one surface with it (one such frame is the noisy
+//    segment the highest-overlap choice keeps from bridging two instances; two are evidence);
 #include "core/common/camera.h"
 #include "core/common/image.h"
 #include "core/planes/plane_fit.h"
@@ -59,8 +62,12 @@ struct GlobalPlane {
   Footprint footprint;                 // in the basis fixed at creation
   int64_t first_seen = 0, last_seen = 0;  // frame indices
   int observations = 0;                // frames it was matched in
+  float same_plane_distance = 0.01f;   // the smallest LocalPlane::same_plane_distance it was seen with (closest look)
   bool alive = true;                   // false once absorbed by a merge
   std::vector<int> apart;              // instances seen in one frame as a different surface (ids as recorded)
+  // (instance, frame): a local plane this instance took in that frame matched that instance too and
+  // was one surface with it (ids as recorded). A second such frame merges the two.
+  std::vector<std::pair<int, int64_t>> bridged;
 };
 
 // One local plane of one frame, in the world frame.

@@ -193,6 +193,12 @@ IdStability IdentificationScorer::id_stability(const std::vector<int32_t>& remap
       s.unstable[g] = h;
   }
   const auto by_global = pixels_by_global(remap);
+  for (const auto& [g, h] : hist) {
+    if (s.unstable.contains(g)) continue;
+    const int modal = std::max_element(h.begin(), h.end(), [](const auto& a, const auto& b) { return a.second < b.second; })->first;
+    if (const auto it = by_global.find(modal); it != by_global.end())
+      if (const int owner = majority_key(it->second); owner != g) s.on_other_id[g] = {modal, owner};
+  }
   for (const auto& [g, h] : s.unstable)
     for (const auto& [id, n] : h)
       if (const auto it = by_global.find(id); it != by_global.end()) s.majority_gt[id] = majority_key(it->second);

@@ -60,6 +60,9 @@ struct IdStability {
   // GT planes below 95 %: GT id -> canonical global id -> frames with that id (ordered by id).
   std::map<int, std::map<int, int>> unstable;
   std::map<int, int> majority_gt;  // canonical global id of an unstable plane -> GT id holding most of its pixels
+  // Stable GT planes whose modal id holds mostly another GT plane's pixels (a bookshelf's back on its
+  // wall's id: consistent, but another plane's): GT id -> (canonical id, the GT id holding most of it).
+  std::map<int, std::pair<int, int>> on_other_id;
   double fraction() const { return frames > 0 ? double(consistent) / double(frames) : 1.0; }
 };
 

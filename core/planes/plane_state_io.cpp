@@ -68,10 +68,7 @@ std::vector<FillRegion> PlaneStateIo::read_fill_regions(io::ByteReader& r) {
   return regions;
 }
 
-void PlaneStateIo::write(io::ByteWriter& w, const PlaneIdentifier& id) {
-  w.put<uint32_t>(2);  // format version (2: GlobalPlane::apart)
-  w.put<int64_t>(id.window_);
-  const GlobalPlaneTable& t = id.table_;
+void PlaneStateIo::write_table(io::ByteWriter& w, const GlobalPlaneTable& t) {
   w.put<uint64_t>(t.planes_.size());
   for (const GlobalPlane& g : t.planes_) {
     w.put<int32_t>(g.id);
@@ -85,9 +82,18 @@ void PlaneStateIo::write(io::ByteWriter& w, const PlaneIdentifier& id) {
     w.put<int32_t>(g.observations);
     w.put<uint8_t>(g.alive);
     w.put_vector(std::vector<int32_t>(g.apart.begin(), g.apart.end()));
+    w.put<float>(g.same_plane_distance);
+    w.put<uint64_t>(g.bridged.size());
+    for (const auto& [other, frame] : g.bridged) w.put<int32_t>(other), w.put<int64_t>(frame);
   }
   std::vector<int32_t> parent(t.parent_.begin(), t.parent_.end());
   w.put_vector(parent);
+}
+
+void PlaneStateIo::write(io::ByteWriter& w, const PlaneIdentifier& id) {
+  w.put<uint32_t>(3);  // format version (2: GlobalPlane::apart; 3: same_plane_distance, bridged)
+  w.put<int64_t>(id.window_);
+  write_table(w, id.table_);
   const ReflectiveVote& v = id.vote_;
   w.put<uint64_t>(v.history_.size());
   for (const auto& [plane, hist] : v.history_) {
@@ -99,12 +105,7 @@ void PlaneStateIo::write(io::ByteWriter& w, const PlaneIdentifier& id) {
   w.put_vector(lookup);
 }
 
-void PlaneStateIo::read(io::ByteReader& r, PlaneIdentifier& id) {
-  const auto version = r.get<uint32_t>();
-  if (version != 1 && version != 2)
-    throw std::runtime_error(r.what() + ": unsupported plane state version " + std::to_string(version));
-  id.window_ = r.get<int64_t>();
-  GlobalPlaneTable& t = id.table_;
+void PlaneStateIo::read_table(io::ByteReader& r, GlobalPlaneTable& t, uint32_t version) {
   const auto n = r.get<uint64_t>();
   if (n > r.remaining()) throw std::runtime_error(r.what() + ": corrupt plane count");
   t.planes_.clear();
@@ -125,6 +126,19 @@ void PlaneStateIo::read(io::ByteReader& r, PlaneIdentifier& id) {
         if (x < 1 || uint64_t(x) > n) throw std::runtime_error(r.what() + ": plane id out of range in a seen-apart list");
         g.apart.push_back(x);
       }
+    if (version >= 3) {
+      g.same_plane_distance = r.get<float>();
+      if (!(g.same_plane_distance > 0 && std::isfinite(g.same_plane_distance)))
+        throw std::runtime_error(r.what() + ": plane tolerance is not positive");
+      const auto bridges = r.get<uint64_t>();
+      if (bridges > r.remaining()) throw std::runtime_error(r.what() + ": corrupt bridged list");
+      for (uint64_t k = 0; k < bridges; ++k) {
+        const auto other = r.get<int32_t>();
+        const auto frame = r.get<int64_t>();
+        if (other < 1 || uint64_t(other) > n) throw std::runtime_error(r.what() + ": plane id out of range in a bridged list");
+        g.bridged.emplace_back(other, frame);
+      }
+    }  // older snapshots: the segmenter's 1 cm floor (the tightest) and no bridges
     if (g.id != int(i) + 1) throw std::runtime_error(r.what() + ": plane ids are not 1..n");
     t.planes_.push_back(std::move(g));
   }
@@ -133,6 +147,14 @@ void PlaneStateIo::read(io::ByteReader& r, PlaneIdentifier& id) {
   for (int32_t p : parent)
     if (p < 0 || size_t(p) > t.planes_.size()) throw std::runtime_error(r.what() + ": union-find entry out of range");
   t.parent_.assign(parent.begin(), parent.end());
+}
+
+void PlaneStateIo::read(io::ByteReader& r, PlaneIdentifier& id) {
+  const auto version = r.get<uint32_t>();
+  if (version < 1 || version > 3)
+    throw std::runtime_error(r.what() + ": unsupported plane state version " + std::to_string(version));
+  id.window_ = r.get<int64_t>();
+  read_table(r, id.table_, version);
   ReflectiveVote& v = id.vote_;
   v.history_.clear();
   const auto hn = r.get<uint64_t>();

@@ -16,6 +16,9 @@ struct PlaneStateIo {
   static void write(io::ByteWriter& w, const PlaneIdentifier& id);
   // Throws std::runtime_error (from the reader) on truncated or corrupt data.
   static void read(io::ByteReader& r, PlaneIdentifier& id);
+  // The global plane table alone, as write / read store it (read_table: in that format `version`).
+  static void write_table(io::ByteWriter& w, const GlobalPlaneTable& t);
+  static void read_table(io::ByteReader& r, GlobalPlaneTable& t, uint32_t version);
 
   static void write_fill_regions(io::ByteWriter& w, std::span<const FillRegion> regions);
   static std::vector<FillRegion> read_fill_regions(io::ByteReader& r);  // throws as read()

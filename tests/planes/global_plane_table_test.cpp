@@ -2,6 +2,8 @@
 // choice, union-find merges and the remap table, each on hand-made floor patches (world z = 0).
 #include "core/planes/global_plane_table.h"
 
+#include "core/planes/plane_state_io.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -140,6 +142,53 @@ TEST(GlobalPlaneTable, BestOverlapWinsAmongMatchingCandidates) {
   const FrameAssociation a = t.associate(obs, 1);
   EXPECT_EQ(a.local_to_global[1], 2);  // the higher overlap, not a bridge of both
   EXPECT_TRUE(a.merges.empty());
+  EXPECT_EQ(t.live_ids().size(), 2u);
+}
+
+// The highest-overlap choice keeps one segment from bridging two instances (above); a second frame
+// in which a piece of one is one surface with the other is evidence, and merges them. The record of
+// the first frame survives a snapshot of the table, with each instance's closest-look tolerance.
+TEST(GlobalPlaneTable, TwoFramesOfOneSurfaceBridgingTwoInstancesMergeThem) {
+  GlobalPlaneTable t;
+  associate_one(t, patch(1, 0, 1, 0, 1), 0);        // 1
+  LocalObservation far = patch(1, 1.5f, 2.5f, 0, 1);
+  far.same_plane_distance = 0.02f;
+  associate_one(t, far, 0);                         // 2, seen from farther away
+  const LocalObservation bridge = patch(1, 0.9f, 2.5f, 0, 1);
+  EXPECT_EQ(associate_one(t, bridge, 10), 2);
+  EXPECT_EQ(t.live_ids().size(), 2u);               // one frame: no merge
+  ASSERT_EQ(t.find(2)->bridged.size(), 1u);
+  EXPECT_FLOAT_EQ(t.find(2)->same_plane_distance, 0.01f);  // the bridge was the closer look
+
+  io::ByteWriter w;
+  PlaneStateIo::write_table(w, t);
+  GlobalPlaneTable loaded;
+  io::ByteReader r(w.bytes(), "table");
+  PlaneStateIo::read_table(r, loaded, 3);
+  EXPECT_FLOAT_EQ(loaded.find(1)->same_plane_distance, 0.01f);
+  EXPECT_FLOAT_EQ(loaded.find(2)->same_plane_distance, 0.01f);
+
+  const LocalObservation again[] = {bridge};
+  const FrameAssociation a = loaded.associate(again, 20);
+  EXPECT_EQ(a.local_to_global[1], 1);
+  EXPECT_EQ(a.merges, (std::vector<std::pair<int, int>>{{1, 2}}));
+  EXPECT_EQ(loaded.live_ids(), (std::vector<int>{1}));
+}
+
+// A segment on the plane z = 0 that also matches an instance 5 cm above it (within the 0.1 m
+// filter, overlapping its footprint's edge) is not one surface with it: repeated, it merges nothing.
+TEST(GlobalPlaneTable, ABridgeToAnotherLayerMergesNothing) {
+  GlobalPlaneTable t;
+  associate_one(t, patch(1, 0, 1, 0, 1), 0);                 // 1: z = 0
+  associate_one(t, patch(1, 1.5f, 2.5f, 0, 1, 0.05f), 0);    // 2: z = 5 cm
+  const LocalObservation bridge = patch(1, 0.9f, 1.6f, 0, 1);  // reaches 10 cm under 2
+  const auto scores = t.score(bridge, 10);
+  ASSERT_EQ(scores.size(), 2u);
+  ASSERT_TRUE(scores[0].matched && scores[1].matched);
+  for (int64_t frame : {10, 20, 30}) {
+    EXPECT_EQ(associate_one(t, bridge, frame), 1);
+    EXPECT_TRUE(t.find(1)->bridged.empty());
+  }
   EXPECT_EQ(t.live_ids().size(), 2u);
 }
 
