@@ -150,8 +150,9 @@ std::vector<CandidateScore> GlobalPlaneTable::score(const LocalObservation& obs,
   return out;
 }
 
-void GlobalPlaneTable::absorb(GlobalPlane& g, const LocalObservation& obs, int64_t frame) {
-  for (const Eigen::Vector3f& p : obs.points) g.moments.add(p);
+void GlobalPlaneTable::absorb(GlobalPlane& g, const LocalObservation& obs, const PlaneMoments& moments,
+                              int64_t frame) {
+  g.moments.merge(moments);
   const PlaneFit fit = fit_plane(g.moments);
   if (fit.valid) {
     g.plane = fit.plane;
@@ -165,7 +166,7 @@ void GlobalPlaneTable::absorb(GlobalPlane& g, const LocalObservation& obs, int64
                                               : std::min(g.same_plane_distance, obs.same_plane_distance);
 }
 
-int GlobalPlaneTable::create(const LocalObservation& obs, int64_t frame) {
+int GlobalPlaneTable::create(const LocalObservation& obs, const PlaneMoments& moments, int64_t frame) {
   GlobalPlane g;
   g.id = int(planes_.size()) + 1;
   g.plane = obs.plane;
@@ -174,7 +175,7 @@ int GlobalPlaneTable::create(const LocalObservation& obs, int64_t frame) {
   g.first_seen = g.last_seen = frame;
   planes_.push_back(std::move(g));
   parent_.push_back(planes_.back().id);
-  absorb(planes_.back(), obs, frame);
+  absorb(planes_.back(), obs, moments, frame);
   planes_.back().plane.n = planes_.back().plane.n.normalized();
   return planes_.back().id;
 }
@@ -250,10 +251,10 @@ FrameAssociation GlobalPlaneTable::associate(std::span<const LocalObservation> o
         }
     const bool created = id == 0;
     if (created) {
-      id = create(obs, frame);
+      id = create(obs, f.moments, frame);
       ++out.created;
     } else {
-      absorb(planes_[size_t(id - 1)], obs, frame);
+      absorb(planes_[size_t(id - 1)], obs, f.moments, frame);
     }
     out.local_to_global[size_t(obs.local_id)] = id;
     if (std::find(touched.begin(), touched.end(), id) == touched.end()) touched.push_back(id);

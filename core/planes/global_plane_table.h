@@ -124,8 +124,9 @@ class GlobalPlaneTable {
   friend struct PlaneStateIo;  // snapshots (plane_state_io.h)
   float cos_max_normal_angle() const;  // cos of the geometric filter's normal angle
   bool geometric_match(const Plane& a, const Eigen::Vector3f& centroid_b) const;
-  void absorb(GlobalPlane& into, const LocalObservation& obs, int64_t frame);
-  int create(const LocalObservation& obs, int64_t frame);
+  // `moments`: of obs.points, computed once per frame by associate().
+  void absorb(GlobalPlane& into, const LocalObservation& obs, const PlaneMoments& moments, int64_t frame);
+  int create(const LocalObservation& obs, const PlaneMoments& moments, int64_t frame);
   void merge_pass(std::span<const int> touched, FrameAssociation& out);
 
   GlobalPlaneParams params_;
